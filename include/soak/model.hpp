@@ -1,0 +1,104 @@
+// Model: everything that stays constant during a run (topology, rest shape, parameters, colliders,
+// emitters). Built once by the scene loader; read-only for the step.
+#pragma once
+#include <soak/math.hpp>
+#include <soak/params.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace soak {
+
+// phase of a particle: 0 is water, k + 1 is cloth piece k (the paper's Flag, section 5)
+constexpr int32_t kWaterPhase = 0;
+inline bool isWater(int32_t phase) { return phase == kWaterPhase; }
+inline int clothPiece(int32_t phase) { return phase - 1; }
+
+// kinematic pose of a collider at a time; rotation then translation maps local to world
+struct Keyframe {
+  float time = 0.0f;         // s
+  Vec3 translation{0, 0, 0}; // m
+  Quat rotation{1, 0, 0, 0};
+};
+
+enum class ColliderShape { Plane, Box, Container, Sphere, Capsule };
+
+struct Collider {
+  std::string name;
+  ColliderShape shape = ColliderShape::Plane;
+  // local-frame geometry: plane y = 0 with normal +y; box / container centred with halfExtents;
+  // sphere centred with radius; capsule along local y with halfHeight (segment) and radius
+  Vec3 halfExtents{0.5f, 0.5f, 0.5f};  // m
+  float radius = 0.5f;                 // m
+  float halfHeight = 0.5f;             // m
+  float wallThickness = 0.04f;         // m, container walls (open top)
+  float friction = 0.3f;               // 0..1: fraction of the tangential slip removed on contact
+  float restitution = 0.0f;            // 0..1: normal velocity kept, reversed, on contact
+  std::vector<Keyframe> keys;          // at least one; linear translation, slerp rotation, clamped ends
+};
+
+enum class EmitterKind { Block, Jet };
+
+struct Emitter {
+  std::string name;
+  EmitterKind kind = EmitterKind::Block;
+  // block: a lattice of particles filling [boxMin, boxMax] at the water spacing, emitted at `start`
+  Vec3 boxMin{0, 0, 0}, boxMax{0, 0, 0};  // m
+  Vec3 velocity{0, 0, 0};                 // m/s, initial velocity of a block
+  // jet: a disc of particles of `radius` at `origin`, moving along `direction` at `speed`
+  Vec3 origin{0, 0, 0};
+  Vec3 direction{0, -1, 0};  // unit
+  float speed = 4.0f;        // m/s (Fig. 1)
+  float radius = 0.05f;      // m
+  float start = 0.0f;        // s
+  float end = 1.0e30f;       // s
+};
+
+// a cloth piece occupies particles [firstParticle, firstParticle + particleCount) and triangles
+// [firstTriangle, firstTriangle + triangleCount); cloth particles come before every water particle
+struct ClothPiece {
+  std::string name;
+  int firstParticle = 0, particleCount = 0;
+  int firstTriangle = 0, triangleCount = 0;
+  ClothMaterial material;
+};
+
+// Eq. 8 constraints as a struct of arrays; solved colour by colour (no two share a particle)
+struct StretchConstraints {
+  std::vector<std::array<int, 2>> ids;
+  std::vector<float> restLength;   // m
+  std::vector<float> compliance;   // m/N (XPBD alpha)
+  std::vector<int> colorStart;     // constraints of colour c are [colorStart[c], colorStart[c+1])
+};
+
+// Eq. 9 constraints: ids = {shared edge a, shared edge b, wing c, wing d}
+struct BendConstraints {
+  std::vector<std::array<int, 4>> ids;
+  std::vector<float> restAngle;    // rad, signed dihedral angle at rest
+  std::vector<float> compliance;   // 1/(N m)
+  std::vector<int> colorStart;
+};
+
+struct Model {
+  SolverParams solver;
+  WaterParams water;
+
+  std::vector<ClothPiece> pieces;
+  int numCloth = 0;                              // cloth particles are [0, numCloth)
+  std::vector<std::array<int, 3>> triangles;     // cloth triangles, particle indices
+  std::vector<Vec3> clothRestPosition;           // m, per cloth particle (initial shape)
+  std::vector<float> clothDryMass;               // kg, per cloth particle
+  std::vector<uint8_t> clothPinned;              // 1 = follows clothRestPosition (kinematic)
+  std::vector<int> vertexTriangleStart;          // CSR: triangles around a cloth particle
+  std::vector<int> vertexTriangles;
+  std::vector<int> vertexNeighborStart;          // CSR: cloth particles sharing an edge (1-ring)
+  std::vector<int> vertexNeighbors;              // sorted per particle
+  StretchConstraints stretch;
+  BendConstraints bend;
+
+  std::vector<Collider> colliders;
+  std::vector<Emitter> emitters;
+};
+
+}  // namespace soak

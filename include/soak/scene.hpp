@@ -1,0 +1,38 @@
+// scene files: JSON, SI units, every key validated before anything runs (docs/scene-format.md)
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+#include <string>
+#include <vector>
+
+namespace soak {
+
+struct OutputSettings {
+  int frames = 100;          // frames to simulate and write
+  int stepsPerFrame = 2;     // steps of solver.dt between two written frames
+  bool clothObj = true;      // cloth_NNNN.obj
+  bool clothPly = true;      // cloth_NNNN.ply (per-vertex attributes)
+  bool water = true;         // water_NNNN.ply (binary particles)
+};
+
+struct Scene {
+  std::string path;          // file it came from ("<string>" when parsed from memory)
+  std::string name;
+  std::string description;
+  Model model;
+  State state;               // initial state (cloth particles placed, blocks not yet emitted)
+  OutputSettings output;
+};
+
+// loads and validates a scene file. overrides are "json.path=value" strings applied before
+// validation (value parsed as JSON, else taken as a string), e.g. "solver.substeps=3" or
+// "cloth.0.material.thickness=0.02". Throws soak::Error naming the file, the JSON path and what was
+// expected.
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// the same from JSON text; relative mesh paths resolve against baseDir
+Scene loadSceneFromString(const std::string& text, const std::string& sourceName, const std::string& baseDir,
+                          const std::vector<std::string>& overrides = {});
+
+}  // namespace soak

@@ -1,0 +1,50 @@
+// State: everything the step changes. Particle data is a struct of arrays, float32, indexed by
+// particle; cloth particles are [0, model.numCloth), water particles follow.
+#pragma once
+#include <soak/math.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace soak {
+
+struct Particles {
+  std::vector<int32_t> phase;     // 0 water, k + 1 cloth piece k
+  std::vector<uint32_t> id;       // stable id for output; never reused within a run
+  std::vector<float> mass;        // kg
+  std::vector<float> invMass;     // 1/kg; 0 for pinned cloth
+  std::vector<float> radius;      // m, SPH support radius h_i (adaptive water particles differ)
+  std::vector<Vec3> x;            // m, position at the start of the step
+  std::vector<Vec3> xPred;        // m, predicted position x* (Algorithm 1)
+  std::vector<Vec3> v;            // m/s
+
+  size_t size() const { return x.size(); }
+  void resize(size_t n);
+  // append one particle; returns its index
+  size_t add(int32_t phase, uint32_t id, float mass, float radius, const Vec3& x, const Vec3& v);
+  // keep the particles whose keep[i] != 0, in order (stable, deterministic)
+  void compact(const std::vector<uint8_t>& keep);
+};
+
+// where the water is: the sum of these stays constant (free + held + buffers + removed - emitted)
+struct WaterLedger {
+  double emitted = 0.0;            // kg, created by emitters
+  double removedAtBounds = 0.0;    // kg, water particles that left the domain
+  uint64_t particlesRemovedAtBounds = 0;
+};
+
+struct EmitterState {
+  double emittedLength = 0.0;      // m of jet emitted so far (a new disc every spacing)
+  bool done = false;
+};
+
+struct State {
+  double time = 0.0;               // s
+  uint64_t stepCount = 0;
+  uint32_t nextId = 0;
+  Particles particles;
+  WaterLedger ledger;
+  std::vector<EmitterState> emitters;
+};
+
+}  // namespace soak

@@ -1,0 +1,30 @@
+// one simulation step of the unified position-based engine (Algorithm 1 of Shao et al. 2017)
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+#include <soak/stats.hpp>
+
+#include <memory>
+
+namespace soak {
+
+struct Workspace;  // scratch buffers (grid, neighbour lists, lambdas); reused step after step
+
+struct WorkspaceDeleter {
+  void operator()(Workspace* w) const;
+};
+using WorkspacePtr = std::unique_ptr<Workspace, WorkspaceDeleter>;
+WorkspacePtr makeWorkspace();
+
+// advances state by dt (split into model.solver.substeps substeps). Does not throw; a diverged
+// state is reported by checkState.
+void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats);
+
+// returns an empty string when every particle is finite and below model.solver.maxSpeed, else a
+// message naming the first bad particle
+std::string checkState(const Model& model, const State& state);
+
+// 64-bit FNV-1a hash of positions, velocities, masses and ids: equal states hash equal
+uint64_t stateHash(const State& state);
+
+}  // namespace soak

@@ -1,0 +1,21 @@
+// parallel loops: static OpenMP schedule over contiguous ranges. Every loop gathers (writes only its
+// own index), so results do not depend on the thread count.
+#pragma once
+#include <omp.h>
+
+#include <cstdint>
+
+namespace soak {
+
+template <class F>
+inline void parallelFor(int64_t n, F&& body) {
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < n; ++i) body(i);
+}
+
+inline int threadCount() { return omp_get_max_threads(); }
+inline void setThreadCount(int n) {
+  if (n > 0) omp_set_num_threads(n);
+}
+
+}  // namespace soak

@@ -1,0 +1,65 @@
+// neighbour search: a hashed uniform grid filled by counting sort (cellStart / cellEntries), rebuilt
+// every step without allocation after warm-up, and per-particle neighbour lists built from it.
+// Two particles are neighbours when |x_i - x_j| < h_ij = (h_i + h_j) / 2 (per-particle radii).
+#pragma once
+#include <soak/math.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace soak {
+
+struct NeighborGrid {
+  float cellSize = 0.0f;                // m, at least the largest support radius
+  uint32_t tableMask = 0;               // hash table size - 1 (a power of two)
+  std::vector<uint32_t> cellStart;      // size table + 1; bucket b holds cellEntries[cellStart[b] ..)
+  std::vector<uint32_t> cellEntries;    // particle indices sorted by bucket, ascending within one
+  std::vector<uint32_t> particleBucket; // bucket of each particle
+
+  Eigen::Vector3i cellOf(const Vec3& p) const {
+    return {static_cast<int>(std::floor(p.x() / cellSize)), static_cast<int>(std::floor(p.y() / cellSize)),
+            static_cast<int>(std::floor(p.z() / cellSize))};
+  }
+  uint32_t bucketOf(const Eigen::Vector3i& c) const {
+    const uint32_t h = (static_cast<uint32_t>(c.x()) * 92837111u) ^ (static_cast<uint32_t>(c.y()) * 689287499u) ^
+                       (static_cast<uint32_t>(c.z()) * 283923481u);
+    return h & tableMask;
+  }
+
+  // calls f(j) once for every particle j in the 27 cells around p (a superset of those within
+  // cellSize of p), in a fixed order; buckets shared by two cells are visited once
+  template <class F>
+  void forEachCandidate(const Vec3& p, F&& f) const {
+    const Eigen::Vector3i c = cellOf(p);
+    uint32_t seen[27];
+    int nSeen = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const uint32_t b = bucketOf(c + Eigen::Vector3i(dx, dy, dz));
+          bool dup = false;
+          for (int s = 0; s < nSeen; ++s) dup |= (seen[s] == b);
+          if (dup) continue;
+          seen[nSeen++] = b;
+          for (uint32_t k = cellStart[b]; k < cellStart[b + 1]; ++k) f(cellEntries[k]);
+        }
+  }
+};
+
+// neighbour lists, kept through the solver iterations of a step: neighbours of i are
+// index[start[i] .. start[i + 1]), excluding i itself, in a fixed order
+struct NeighborLists {
+  std::vector<uint32_t> start;
+  std::vector<uint32_t> index;
+  uint32_t count(size_t i) const { return start[i + 1] - start[i]; }
+};
+
+// fills the grid for positions x with the given cell size (counting sort, deterministic)
+void buildGrid(const std::vector<Vec3>& x, float cellSize, NeighborGrid& grid);
+
+// neighbour lists for every particle from a grid built on the same positions
+void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
+                        NeighborLists& lists);
+
+}  // namespace soak

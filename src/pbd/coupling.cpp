@@ -1,0 +1,152 @@
+#include "pbd/coupling.hpp"
+
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <omp.h>
+
+namespace soak {
+
+namespace {
+
+// closest point of triangle (a, b, c) to p as barycentric weights (Ericson, Real-Time Collision
+// Detection, 5.1.5)
+Vec3 closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0f && d2 <= 0.0f) return {1, 0, 0};
+  const Vec3 bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0f && d4 <= d3) return {0, 1, 0};
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) {
+    const float v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const Vec3 cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0f && d5 <= d6) return {0, 0, 1};
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) {
+    const float w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) {
+    const float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const float denom = 1.0f / (va + vb + vc);
+  const float v = vb * denom, w = vc * denom;
+  return {1 - v - w, v, w};
+}
+
+}  // namespace
+
+float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const Vec3& xc, float side, float thickness,
+                         Vec3& normal, Vec3& bary) {
+  const Vec3 nrm = (xb - xa).cross(xc - xa);
+  const float len = nrm.norm();
+  if (len < 1e-12f) {
+    normal = Vec3::Zero();
+    bary = Vec3::Zero();
+    return 0.0f;
+  }
+  normal = nrm / len;
+  bary = closestBarycentric(xq, xa, xb, xc);
+  const Vec3 pt = bary.x() * xa + bary.y() * xb + bary.z() * xc;
+  return side * (xq - pt).dot(normal) - thickness;
+}
+
+uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb, CouplingScratch& s, bool rigidCloth) {
+  const int64_t nc = model.numCloth;
+  const int64_t n = static_cast<int64_t>(p.size());
+  if (nc == 0 || n == nc) return 0;
+  const int nThreads = omp_get_max_threads();
+  s.perThread.resize(static_cast<size_t>(nThreads));
+  if (s.triangleStiffness.size() != model.triangles.size()) s.triangleStiffness.assign(model.triangles.size(), 1.0f);
+  const int iters = std::max(1, model.solver.couplingIterations);
+
+  // each thread takes one contiguous range of water particles, in order, so concatenating the
+  // per-thread lists gives the contacts in ascending water order for any thread count
+#pragma omp parallel num_threads(nThreads)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    std::vector<CouplingContact>& out = s.perThread[static_cast<size_t>(t)];
+    out.clear();
+    const int64_t nw = n - nc;
+    const int64_t begin = nc + nw * t / nt, end = nc + nw * (t + 1) / nt;
+    std::vector<uint32_t> tris;
+    for (int64_t q = begin; q < end; ++q) {
+      // candidate triangles: those around the cloth particles in q's neighbourhood, each once
+      tris.clear();
+      for (uint32_t k = nb.start[q]; k < nb.start[q + 1]; ++k) {
+        const uint32_t j = nb.index[k];
+        if (static_cast<int64_t>(j) >= nc) continue;
+        for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e)
+          tris.push_back(static_cast<uint32_t>(model.vertexTriangles[e]));
+      }
+      if (tris.empty()) continue;
+      std::sort(tris.begin(), tris.end());
+      tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
+      const float wq = p.invMass[q];
+      Vec3 dq = Vec3::Zero();
+      for (uint32_t tri : tris) {
+        const auto& f = model.triangles[tri];
+        const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
+        // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
+        Vec3 n0, b0;
+        const float c0 = couplingConstraint(p.x[q], p.x[f[0]], p.x[f[1]], p.x[f[2]], 1.0f, 0.0f, n0, b0);
+        if (n0.isZero()) continue;
+        const float side = c0 >= 0.0f ? 1.0f : -1.0f;
+        Vec3 nrm, bary;
+        const float C = couplingConstraint(p.xPred[q] + dq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness,
+                                           nrm, bary);
+        if (C >= 0.0f || nrm.isZero()) continue;
+        // only a contact over the triangle's face (or one crossed from it) counts; far below or
+        // beside it is another triangle's business
+        const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
+        const Vec3 off = p.xPred[q] + dq - pt;
+        const float along = std::fabs(off.dot(nrm));
+        if ((off - off.dot(nrm) * nrm).squaredNorm() > 0.25f * thickness * thickness) continue;
+        if (along > p.radius[q] + (p.xPred[q] - p.x[q]).norm()) continue;
+        const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
+                    wc = rigidCloth ? 0.0f : p.invMass[f[2]];
+        const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
+        if (denom <= 0.0f) continue;
+        // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
+        const float k = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
+        const float dl = -C / denom * k;
+        const Vec3 g = side * nrm;
+        dq += wq * dl * g;
+        if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
+        else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+      }
+      p.xPred[q] += dq;  // q's own correction: only this thread writes q
+    }
+  }
+  // cloth corrections summed in water order, averaged per vertex (Jacobi)
+  uint64_t contacts = 0;
+  s.clothDelta.assign(static_cast<size_t>(nc), Vec3::Zero());
+  s.clothCount.assign(static_cast<size_t>(nc), 0u);
+  for (const auto& list : s.perThread) {
+    contacts += list.size();
+    if (rigidCloth) continue;
+    for (const CouplingContact& c : list) {
+      const auto& f = model.triangles[c.triangle];
+      s.clothDelta[f[0]] += c.da;
+      s.clothDelta[f[1]] += c.db;
+      s.clothDelta[f[2]] += c.dc;
+      ++s.clothCount[f[0]];
+      ++s.clothCount[f[1]];
+      ++s.clothCount[f[2]];
+    }
+  }
+  if (!rigidCloth)
+    parallelFor(nc, [&](int64_t i) {
+      if (s.clothCount[i]) p.xPred[i] += s.clothDelta[i] / static_cast<float>(s.clothCount[i]);
+    });
+  return contacts;
+}
+
+}  // namespace soak

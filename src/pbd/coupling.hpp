@@ -1,0 +1,45 @@
+// water-cloth coupling: the particle-triangle constraint of Eq. 21 (Shao 2017), Müller et al.
+// 2007's self-collision constraint, tested on the step's motion so no water crosses a dry cloth
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+#include "grid/grid.hpp"
+
+#include <cmath>
+#include <vector>
+
+namespace soak {
+
+struct CouplingContact {
+  uint32_t triangle;
+  Vec3 da, db, dc;   // m, corrections of the triangle's vertices
+};
+
+struct CouplingScratch {
+  std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
+  std::vector<Vec3> clothDelta;
+  std::vector<uint32_t> clothCount;
+  std::vector<float> triangleStiffness;   // kappa^couple per triangle (Eq. 22 drives it; 1 when dry)
+};
+
+// C = s (x_q - p) . n - d >= 0 (Eq. 21 as corrected in NOTES.md): p the closest point of triangle
+// (a, b, c) to x_q, n its unit normal, s the side x_q came from, d the cloth thickness.
+// Returns C and the barycentric weights of p in bary.
+float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const Vec3& xc, float side, float thickness,
+                         Vec3& normal, Vec3& bary);
+
+// Eq. 5: the per-iteration factor of a stiffness kappa in [0, 1] solved over n iterations
+inline float iterationFactor(float kappa, int iterations) {
+  if (kappa >= 1.0f) return 1.0f;
+  if (kappa <= 0.0f) return 0.0f;
+  return 1.0f - std::pow(1.0f - kappa, 1.0f / static_cast<float>(iterations > 0 ? iterations : 1));
+}
+
+// one pass of the coupling constraint for every water particle against the cloth triangles near it.
+// p.x holds the positions at the start of the substep (the side each particle came from), p.xPred
+// the predicted ones. With rigidCloth the cloth is held still (a final pass that guarantees water
+// ends on its side). Returns the number of contacts.
+uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb, CouplingScratch& s, bool rigidCloth);
+
+}  // namespace soak

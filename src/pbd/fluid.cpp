@@ -1,0 +1,215 @@
+#include "pbd/fluid.hpp"
+
+#include "core/kernels.hpp"
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLists& nb, FluidScratch& s) {
+  const int nc = model.numCloth;
+  s.psi.resize(static_cast<size_t>(nc));
+  const float rho0 = model.water.restDensity;
+  parallelFor(nc, [&](int64_t b) {
+    const float hb = p.radius[b];
+    float sum = poly6(0.0f, hb);  // k includes b itself (NOTES.md on Eq. 10)
+    for (uint32_t k = nb.start[b]; k < nb.start[b + 1]; ++k) {
+      const uint32_t j = nb.index[k];
+      if (p.phase[j] != p.phase[b]) continue;
+      sum += poly6((p.xPred[b] - p.xPred[j]).squaredNorm(), pairRadius(hb, p.radius[j]));
+    }
+    s.psi[b] = rho0 / sum;  // Psi_b = rho0 V_b, V_b = 1 / sum_k W_bk (Akinci et al. 2012)
+  });
+}
+
+// integral of poly6 over the half-space beyond distance d: (K pi / 4) * int_d^h (h^2 - z^2)^4 dz
+float wallKernelFraction(float d, float h, float* dFraction) {
+  const float ad = std::fabs(d);
+  if (ad >= h) {
+    if (dFraction) *dFraction = 0.0f;
+    return d > 0.0f ? 0.0f : 1.0f;
+  }
+  const double hh = h, z = ad, h2 = hh * hh;
+  auto antiderivative = [&](double t) {
+    const double t2 = t * t;
+    return h2 * h2 * h2 * h2 * t - 4.0 / 3.0 * h2 * h2 * h2 * t2 * t + 6.0 / 5.0 * h2 * h2 * t2 * t2 * t -
+           4.0 / 7.0 * h2 * t2 * t2 * t2 * t + t2 * t2 * t2 * t2 * t / 9.0;
+  };
+  const double k = 315.0 / (64.0 * 3.14159265358979323846 * std::pow(hh, 9)) * 3.14159265358979323846 / 4.0;
+  const double beyond = k * (antiderivative(hh) - antiderivative(z));
+  const double q = h2 - z * z;
+  if (dFraction) *dFraction = static_cast<float>(-k * q * q * q * q);  // d/dd, the same on both sides
+  return static_cast<float>(d >= 0.0f ? beyond : 1.0 - beyond);
+}
+
+namespace {
+
+// artificial pressure s_corr = -k (W_ij / W(dq))^n (Macklin 2013 Eq. 13), in lambda units
+float tensileCorrection(const WaterParams& w, float r2, float h, float scale) {
+  if (w.tensileK <= 0.0f) return 0.0f;
+  const float dq = w.tensileDq * h;
+  const float ratio = poly6(r2, h) / poly6(dq * dq, h);
+  return -w.tensileK * std::pow(ratio, static_cast<float>(w.tensileN)) * scale;
+}
+
+// sum_k w_k |grad_k C|^2 of a water particle at rest in a full cubic lattice (for the s_corr scale)
+float restGradientNorm(const WaterParams& w) {
+  const float r0 = w.spacing, h = w.supportRadius, m = w.particleMass, rho0 = w.restDensity;
+  Vec3 gi = Vec3::Zero();
+  float sum = 0.0f;
+  const int n = static_cast<int>(std::ceil(h / r0));
+  for (int z = -n; z <= n; ++z)
+    for (int y = -n; y <= n; ++y)
+      for (int x = -n; x <= n; ++x) {
+        const Vec3 r = Vec3(float(x), float(y), float(z)) * r0;
+        if ((x | y | z) == 0 || r.norm() >= h) continue;
+        const Vec3 g = (m / rho0) * spikyGrad(r, h);
+        gi += g;
+        sum += g.squaredNorm() / m;
+      }
+  return sum + gi.squaredNorm() / m;
+}
+
+}  // namespace
+
+void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
+                FluidScratch& s, int iterations) {
+  const WaterParams& wp = model.water;
+  const size_t n = p.size();
+  const int64_t nc = model.numCloth;
+  const int64_t nw = static_cast<int64_t>(n) - nc;
+  if (nw <= 0) return;
+  const float rho0 = wp.restDensity;
+  s.density.resize(n);
+  s.lambda.resize(n);
+  s.delta.resize(n);
+  if (s.sCorrScale == 0.0f) s.sCorrScale = 1.0f / (wp.particleMass * restGradientNorm(wp));
+  const float sCorrScale = s.sCorrScale;
+
+  for (int it = 0; it < iterations; ++it) {
+    // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
+    parallelFor(nw, [&](int64_t w) {
+      const size_t i = static_cast<size_t>(nc + w);
+      const Vec3 xi = p.xPred[i];
+      const float hi = p.radius[i], mi = p.mass[i];
+      float rho = mi * poly6(0.0f, hi);
+      Vec3 gradI = Vec3::Zero();
+      float sumOthers = 0.0f;  // sum over neighbours of w_k |grad_k C|^2
+      for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+        const uint32_t j = nb.index[k];
+        const Vec3 r = xi - p.xPred[j];
+        const float h = pairRadius(hi, p.radius[j]);
+        const float mj = isWater(p.phase[j]) ? p.mass[j] : s.psi[j];  // cloth: boundary mass Psi_b
+        rho += mj * poly6(r.squaredNorm(), h);
+        const Vec3 g = (mj / rho0) * spikyGrad(r, h);
+        gradI += g;
+        sumOthers += p.invMass[j] * g.squaredNorm();
+      }
+      // colliders as a continuous wall of boundary particles
+      for (size_t c = 0; c < model.colliders.size(); ++c) {
+        Vec3 nrm;
+        const float d = colliderDistance(model.colliders[c], poses[c], xi, &nrm);
+        if (d >= hi) continue;
+        float dphi = 0.0f;
+        rho += rho0 * wallKernelFraction(d, hi, &dphi);
+        gradI += dphi * nrm;
+      }
+      s.density[i] = rho;
+      // inequality: only compressed water pushes, so a free surface does not clump (departure from
+      // Macklin 2013, which also pulls; see docs/models.md)
+      const float C = std::max(rho / rho0 - 1.0f, 0.0f);
+      const float denom = p.invMass[i] * gradI.squaredNorm() + sumOthers + wp.relaxation * p.invMass[i] / (hi * hi);
+      s.lambda[i] = -C / (mi * denom);
+    });
+    // water corrections: dx_i = 1/rho0 sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (+ boundaries)
+    parallelFor(nw, [&](int64_t w) {
+      const size_t i = static_cast<size_t>(nc + w);
+      const Vec3 xi = p.xPred[i];
+      const float hi = p.radius[i], li = s.lambda[i];
+      Vec3 dx = Vec3::Zero();
+      for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+        const uint32_t j = nb.index[k];
+        const Vec3 r = xi - p.xPred[j];
+        const float h = pairRadius(hi, p.radius[j]);
+        if (isWater(p.phase[j])) {
+          const float sc = tensileCorrection(wp, r.squaredNorm(), h, sCorrScale);
+          dx += p.mass[j] * (li + s.lambda[j] + sc) * spikyGrad(r, h);
+        } else {
+          dx += s.psi[j] * li * spikyGrad(r, h);
+        }
+      }
+      for (size_t c = 0; c < model.colliders.size(); ++c) {
+        Vec3 nrm;
+        const float d = colliderDistance(model.colliders[c], poses[c], xi, &nrm);
+        if (d >= hi) continue;
+        float dphi = 0.0f;
+        wallKernelFraction(d, hi, &dphi);
+        dx += rho0 * li * dphi * nrm;
+      }
+      s.delta[i] = dx / rho0;
+    });
+    // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
+    parallelFor(nc, [&](int64_t b) {
+      if (p.invMass[b] == 0.0f) return;
+      Vec3 dx = Vec3::Zero();
+      for (uint32_t k = nb.start[b]; k < nb.start[b + 1]; ++k) {
+        const uint32_t i = nb.index[k];
+        if (!isWater(p.phase[i])) continue;
+        const Vec3 r = p.xPred[i] - p.xPred[b];
+        dx -= p.mass[i] * s.lambda[i] * spikyGrad(r, pairRadius(p.radius[i], p.radius[b]));
+      }
+      s.delta[b] = (p.invMass[b] * s.psi[b] / rho0) * dx;
+    });
+    parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
+      if (i >= nc || p.invMass[i] != 0.0f) p.xPred[i] += s.delta[i];
+    });
+  }
+}
+
+void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt) {
+  const WaterParams& wp = model.water;
+  const size_t n = p.size();
+  const int64_t nc = model.numCloth;
+  const int64_t nw = static_cast<int64_t>(n) - nc;
+  if (nw <= 0 || (wp.viscosity <= 0.0f && wp.vorticity <= 0.0f)) return;
+  s.vNew.resize(n);
+  s.vorticity.resize(n);
+  // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), and XSPH (Eq. 17), volume weighted
+  parallelFor(nw, [&](int64_t w) {
+    const size_t i = static_cast<size_t>(nc + w);
+    const Vec3 vi = p.v[i];
+    Vec3 omega = Vec3::Zero(), blend = Vec3::Zero();
+    for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+      const uint32_t j = nb.index[k];
+      if (!isWater(p.phase[j])) continue;
+      const Vec3 r = p.xPred[i] - p.xPred[j];
+      const float h = pairRadius(p.radius[i], p.radius[j]);
+      const float vol = p.mass[j] / std::max(s.density[j], 1e-3f);
+      const Vec3 vij = p.v[j] - vi;
+      blend += vol * poly6(r.squaredNorm(), h) * vij;
+      omega += vol * vij.cross(spikyGrad(r, h));
+    }
+    s.vorticity[i] = omega;
+    s.vNew[i] = vi + wp.viscosity * blend;
+  });
+  if (wp.vorticity > 0.0f) {
+    // f = epsilon (N x omega), N = eta / |eta|, eta = grad |omega| (Macklin 2013 Eq. 16)
+    parallelFor(nw, [&](int64_t w) {
+      const size_t i = static_cast<size_t>(nc + w);
+      Vec3 eta = Vec3::Zero();
+      for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+        const uint32_t j = nb.index[k];
+        if (!isWater(p.phase[j])) continue;
+        const float vol = p.mass[j] / std::max(s.density[j], 1e-3f);
+        eta += vol * s.vorticity[j].norm() * spikyGrad(p.xPred[i] - p.xPred[j], pairRadius(p.radius[i], p.radius[j]));
+      }
+      const float len = eta.norm();
+      if (len > 1e-9f) s.vNew[i] += dt * wp.vorticity * (eta / len).cross(s.vorticity[i]);
+    });
+  }
+  parallelFor(nw, [&](int64_t w) { p.v[nc + w] = s.vNew[nc + w]; });
+}
+
+}  // namespace soak

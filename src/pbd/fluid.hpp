@@ -1,0 +1,40 @@
+// Position Based Fluids (Macklin & Müller 2013) for the water particles, with cloth particles and
+// colliders acting as boundaries (Akinci et al. 2012), as in section 3.2 of Shao et al. 2017.
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+#include "grid/grid.hpp"
+#include "world/colliders.hpp"
+
+#include <vector>
+
+namespace soak {
+
+struct FluidScratch {
+  std::vector<float> psi;          // kg, Akinci boundary mass Psi_b = rho0 V_b of cloth particles
+  std::vector<float> density;      // kg/m^3, rho_i of water particles (last iteration)
+  std::vector<float> lambda;       // m^2, lambda_i / m_i of the density constraint
+  std::vector<Vec3> delta;         // m, position corrections of the current iteration
+  std::vector<Vec3> vorticity;     // 1/s, omega_i
+  std::vector<Vec3> vNew;          // m/s, velocities after XSPH
+  float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
+};
+
+// Akinci volume of each cloth particle, V_b = 1 / sum_k W_bk over the same piece (Eq. 10), and
+// its boundary mass Psi_b = rho0 V_b
+void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLists& nb, FluidScratch& s);
+
+// fraction of the kernel's mass lying beyond a plane at signed distance d (m) from the particle:
+// the continuous limit of a wall of Akinci boundary particles. Also its derivative wrt d.
+float wallKernelFraction(float d, float h, float* dFraction);
+
+// the PBF density constraint (Eq. 6-7), `iterations` Jacobi iterations on p.xPred; cloth particles
+// are moved by the boundary reaction (two-way coupling)
+void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
+                FluidScratch& s, int iterations);
+
+// XSPH viscosity and vorticity confinement on water velocities (after v = (x* - x)/dt)
+void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt);
+
+}  // namespace soak

@@ -1,0 +1,76 @@
+// the simulation loop of Algorithm 1 (Shao et al. 2017): one line per stage, each stage in its own file
+#include <soak/step.hpp>
+
+#include "core/parallel.hpp"
+#include "pbd/integrate.hpp"
+#include "pbd/workspace.hpp"
+#include "world/emitters.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace soak {
+
+namespace {
+
+struct StageClock {
+  std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
+  double lap() {  // ms since the last lap
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+  }
+};
+
+void substep(const Model& model, State& state, Workspace& ws, float h, StepStats& stats) {
+  Particles& p = state.particles;
+  StageTimes& ms = stats.ms;
+  StageClock clock;
+  stats.emittedParticles += emitWater(model, state, state.time, h);                 // new water (Fig. 1 jet, Fig. 3 block)
+  ms.emit += clock.lap();
+  predictPositions(model, state.time + h, p, h);                                    // v += dt g, x* = x + dt v
+  ms.predict += clock.lap();
+  buildGrid(p.xPred, maxSupportRadius(p), ws.grid);                                 // neighbours of x*
+  buildNeighborLists(p.xPred, p.radius, ws.grid, ws.neighbors);
+  ms.neighbors += clock.lap();
+  updateColliderPoses(model, state.time + h, ws.poses);
+  computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
+  solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
+  ms.water += clock.lap();
+  solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // stretch Eq. 8, bend Eq. 9
+  clothSelfCollision(model, p, ws.neighbors, ws.cloth);
+  ms.cloth += clock.lap();
+  projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction
+  ms.colliders += clock.lap();
+  for (int it = 0; it < model.solver.couplingIterations; ++it)                     // water-cloth, Eq. 21-22
+    stats.couplingContacts += solveCoupling(model, p, ws.neighbors, ws.coupling, false);
+  solveCoupling(model, p, ws.neighbors, ws.coupling, true);                         // no water crosses the cloth
+  ms.coupling += clock.lap();
+  updateVelocities(model, p, h);                                                    // v = (x* - x) / dt, damping
+  applyColliderRestitution(model, ws.poses, ws.contactNormal, p);
+  fluidVelocityPass(model, p, ws.neighbors, ws.fluid, h);                           // XSPH, vorticity
+  stats.meanDensityRatio = meanDensityRatio(model, p, ws.fluid);
+  commitPositions(p);                                                               // x = x*
+  stats.removedParticles += removeOutsideDomain(model, state, ws.keep);             // counted in the ledger
+  ms.velocities += clock.lap();
+  state.time += h;
+}
+
+}  // namespace
+
+void WorkspaceDeleter::operator()(Workspace* w) const { delete w; }
+WorkspacePtr makeWorkspace() { return WorkspacePtr(new Workspace()); }
+
+void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats) {
+  const auto start = std::chrono::steady_clock::now();
+  const int n = std::max(1, model.solver.substeps);
+  const float h = dt / static_cast<float>(n);
+  for (int s = 0; s < n; ++s) substep(model, state, ws, h, stats);
+  stats.substeps += n;
+  stats.maxSpeed = maxSpeed(state.particles);
+  ++state.stepCount;
+  stats.ms.total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace soak

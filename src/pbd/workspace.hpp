@@ -1,0 +1,26 @@
+// scratch buffers of the step, reused from step to step (no allocation after warm-up)
+#pragma once
+#include <soak/step.hpp>
+
+#include "grid/grid.hpp"
+#include "pbd/cloth.hpp"
+#include "pbd/coupling.hpp"
+#include "pbd/fluid.hpp"
+#include "world/colliders.hpp"
+
+#include <vector>
+
+namespace soak {
+
+struct Workspace {
+  NeighborGrid grid;
+  NeighborLists neighbors;
+  std::vector<ColliderPose> poses;      // collider poses at the end of the substep
+  std::vector<Vec3> contactNormal;      // collider contact normal per particle, zero when none
+  FluidScratch fluid;
+  ClothScratch cloth;
+  CouplingScratch coupling;
+  std::vector<uint8_t> keep;            // particles kept after the domain check
+};
+
+}  // namespace soak

@@ -1,0 +1,43 @@
+// rigid colliders (plane, box, open container, sphere, capsule) with kinematic keyframed motion,
+// friction and restitution. Shared by both cloth solvers and the water.
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+#include <vector>
+
+namespace soak {
+
+// world pose of a collider at time t and its rigid velocity field
+struct ColliderPose {
+  Vec3 translation{0, 0, 0};
+  Quat rotation{1, 0, 0, 0};
+  Vec3 linearVelocity{0, 0, 0};   // m/s of the local origin
+  Vec3 angularVelocity{0, 0, 0};  // rad/s, world frame
+  Vec3 velocityAt(const Vec3& p) const { return linearVelocity + angularVelocity.cross(p - translation); }
+};
+
+// pose at time t: translation interpolated linearly between keyframes, rotation by slerp, the ends
+// held; velocities from the keyframe segment containing t
+ColliderPose colliderPose(const Collider& c, double t);
+
+// signed distance (m, negative inside the solid) from world point p to the collider, and the unit
+// outward normal of the nearest surface in `normal` (world frame)
+float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal);
+
+// contact margin of a particle against colliders: water keeps half its spacing, cloth half its
+// thickness
+float contactMargin(const Model& model, int32_t phase);
+
+// pushes every predicted position x* out of every collider (distance >= margin), removing the
+// fraction `friction` of the tangential motion relative to the collider over this substep.
+// contactNormal[i] is set to the world normal of the last contact of particle i, or zero.
+void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
+                      std::vector<Vec3>& contactNormal);
+
+// after v = (x* - x)/dt: a particle in contact that moves into the collider along the normal gets
+// its relative normal velocity reversed and scaled by the collider's restitution
+void applyColliderRestitution(const Model& model, const std::vector<ColliderPose>& poses,
+                              const std::vector<Vec3>& contactNormal, Particles& p);
+
+}  // namespace soak

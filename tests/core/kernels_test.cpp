@@ -1,0 +1,80 @@
+#include "core/kernels.hpp"
+#include "pbd/fluid.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace soak;
+
+namespace {
+// midpoint-rule integral of f over the cube [-h, h]^3
+template <class F>
+double integrate3(float h, int n, F&& f) {
+  const double dx = 2.0 * h / n;
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const Vec3 r(float(-h + (i + 0.5) * dx), float(-h + (j + 0.5) * dx), float(-h + (k + 0.5) * dx));
+        sum += f(r);
+      }
+  return sum * dx * dx * dx;
+}
+}  // namespace
+
+TEST(Kernels, Poly6AndSpikyIntegrateToOne) {
+  for (float h : {0.04f, 0.1f, 1.0f}) {
+    EXPECT_NEAR(integrate3(h, 120, [&](const Vec3& r) { return poly6(r.squaredNorm(), h); }), 1.0, 2e-3) << h;
+    EXPECT_NEAR(integrate3(h, 120, [&](const Vec3& r) { return spiky(r.norm(), h); }), 1.0, 5e-3) << h;
+  }
+}
+
+TEST(Kernels, ZeroOutsideSupport) {
+  EXPECT_EQ(poly6(0.04f * 0.04f, 0.04f), 0.0f);
+  EXPECT_EQ(spiky(0.05f, 0.04f), 0.0f);
+  EXPECT_TRUE(spikyGrad(Vec3(0.05f, 0, 0), 0.04f).isZero());
+  EXPECT_EQ(viscosityLaplacian(0.04f, 0.04f), 0.0f);
+  EXPECT_GT(viscosityLaplacian(0.01f, 0.04f), 0.0f);
+}
+
+TEST(Kernels, SpikyGradientMatchesFiniteDifferences) {
+  const float h = 0.04f;
+  const Vec3 pts[] = {{0.01f, 0.002f, -0.005f}, {-0.02f, 0.01f, 0.015f}, {0.0f, 0.03f, 0.001f}};
+  for (const Vec3& r : pts) {
+    const Vec3 g = spikyGrad(r, h);
+    for (int a = 0; a < 3; ++a) {
+      const double e = 1e-4;
+      Eigen::Vector3d rp = r.cast<double>(), rm = r.cast<double>();
+      rp[a] += e;
+      rm[a] -= e;
+      auto w = [&](const Eigen::Vector3d& x) { const double d = h - x.norm(); return 15.0 / (M_PI * std::pow(h, 6)) * d * d * d; };
+      const double fd = (w(rp) - w(rm)) / (2 * e);
+      EXPECT_NEAR(g[a], fd, 1e-3 * std::abs(fd) + 1e-2) << a;
+    }
+  }
+}
+
+TEST(Kernels, WallFractionIsTheHalfSpaceIntegral) {
+  const float h = 0.04f;
+  float dphi = 0.0f;
+  EXPECT_NEAR(wallKernelFraction(0.0f, h, &dphi), 0.5f, 1e-5f);
+  EXPECT_NEAR(wallKernelFraction(h, h, nullptr), 0.0f, 1e-6f);
+  EXPECT_NEAR(wallKernelFraction(-h, h, nullptr), 1.0f, 1e-6f);
+  for (float d : {-0.03f, -0.01f, 0.005f, 0.02f, 0.035f}) {
+    // direct midpoint integral of poly6 over the slab y in [d, h] (the half-space beyond the plane)
+    const int n = 100;
+    const double dxz = 2.0 * h / n, dy = (h - d) / n;
+    double direct = 0.0;
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const Vec3 r(float(-h + (i + 0.5) * dxz), float(d + (j + 0.5) * dy), float(-h + (k + 0.5) * dxz));
+          direct += poly6(r.squaredNorm(), h) * dxz * dxz * dy;
+        }
+    EXPECT_NEAR(wallKernelFraction(d, h, &dphi), direct, 3e-3) << d;
+    const float e = 1e-4f;
+    const float fd = (wallKernelFraction(d + e, h, nullptr) - wallKernelFraction(d - e, h, nullptr)) / (2 * e);
+    EXPECT_NEAR(dphi, fd, 2e-2f * std::abs(fd) + 1e-2f) << d;
+  }
+}
