@@ -7,9 +7,12 @@
 
 namespace soak {
 
+// below this many items a loop runs on the calling thread: the fork costs more than it saves
+constexpr int64_t kParallelGrain = 2048;
+
 template <class F>
 inline void parallelFor(int64_t n, F&& body) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelGrain)
   for (int64_t i = 0; i < n; ++i) body(i);
 }
 

@@ -1,5 +1,7 @@
 #include "pbd/fluid.hpp"
 
+#include "pbd/boundary.hpp"
+
 #include "core/kernels.hpp"
 #include "core/parallel.hpp"
 
@@ -24,26 +26,6 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
   });
 }
 
-// integral of poly6 over the half-space beyond distance d: (K pi / 4) * int_d^h (h^2 - z^2)^4 dz
-float wallKernelFraction(float d, float h, float* dFraction) {
-  const float ad = std::fabs(d);
-  if (ad >= h) {
-    if (dFraction) *dFraction = 0.0f;
-    return d > 0.0f ? 0.0f : 1.0f;
-  }
-  const double hh = h, z = ad, h2 = hh * hh;
-  auto antiderivative = [&](double t) {
-    const double t2 = t * t;
-    return h2 * h2 * h2 * h2 * t - 4.0 / 3.0 * h2 * h2 * h2 * t2 * t + 6.0 / 5.0 * h2 * h2 * t2 * t2 * t -
-           4.0 / 7.0 * h2 * t2 * t2 * t2 * t + t2 * t2 * t2 * t2 * t / 9.0;
-  };
-  const double k = 315.0 / (64.0 * 3.14159265358979323846 * std::pow(hh, 9)) * 3.14159265358979323846 / 4.0;
-  const double beyond = k * (antiderivative(hh) - antiderivative(z));
-  const double q = h2 - z * z;
-  if (dFraction) *dFraction = static_cast<float>(-k * q * q * q * q);  // d/dd, the same on both sides
-  return static_cast<float>(d >= 0.0f ? beyond : 1.0 - beyond);
-}
-
 namespace {
 
 // artificial pressure s_corr = -k (W_ij / W(dq))^n (Macklin 2013 Eq. 13), in lambda units
@@ -51,7 +33,9 @@ float tensileCorrection(const WaterParams& w, float r2, float h, float scale) {
   if (w.tensileK <= 0.0f) return 0.0f;
   const float dq = w.tensileDq * h;
   const float ratio = poly6(r2, h) / poly6(dq * dq, h);
-  return -w.tensileK * std::pow(ratio, static_cast<float>(w.tensileN)) * scale;
+  float power = 1.0f;
+  for (int k = 0; k < w.tensileN; ++k) power *= ratio;
+  return -w.tensileK * power * scale;
 }
 
 // sum_k w_k |grad_k C|^2 of a water particle at rest in a full cubic lattice (for the s_corr scale)
@@ -87,6 +71,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   s.delta.resize(n);
   if (s.sCorrScale == 0.0f) s.sCorrScale = 1.0f / (wp.particleMass * restGradientNorm(wp));
   const float sCorrScale = s.sCorrScale;
+  boundaryParts(model, poses, s.parts);
 
   for (int it = 0; it < iterations; ++it) {
     // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
@@ -108,14 +93,9 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         sumOthers += p.invMass[j] * g.squaredNorm();
       }
       // colliders as a continuous wall of boundary particles
-      for (size_t c = 0; c < model.colliders.size(); ++c) {
-        Vec3 nrm;
-        const float d = colliderDistance(model.colliders[c], poses[c], xi, &nrm);
-        if (d >= hi) continue;
-        float dphi = 0.0f;
-        rho += rho0 * wallKernelFraction(d, hi, &dphi);
-        gradI += dphi * nrm;
-      }
+      Vec3 gradWall;
+      rho += rho0 * boundaryFraction(s.parts, xi, hi, &gradWall);
+      gradI += gradWall;
       s.density[i] = rho;
       // inequality: only compressed water pushes, so a free surface does not clump (departure from
       // Macklin 2013, which also pulls; see docs/models.md)
@@ -140,14 +120,8 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
           dx += s.psi[j] * li * spikyGrad(r, h);
         }
       }
-      for (size_t c = 0; c < model.colliders.size(); ++c) {
-        Vec3 nrm;
-        const float d = colliderDistance(model.colliders[c], poses[c], xi, &nrm);
-        if (d >= hi) continue;
-        float dphi = 0.0f;
-        wallKernelFraction(d, hi, &dphi);
-        dx += rho0 * li * dphi * nrm;
-      }
+      Vec3 gradWall;
+      if (boundaryFraction(s.parts, xi, hi, &gradWall) > 0.0f) dx += rho0 * li * gradWall;
       s.delta[i] = dx / rho0;
     });
     // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
@@ -176,7 +150,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   if (nw <= 0 || (wp.viscosity <= 0.0f && wp.vorticity <= 0.0f)) return;
   s.vNew.resize(n);
   s.vorticity.resize(n);
-  // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), and XSPH (Eq. 17), volume weighted
+  // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), and XSPH (Eq. 17) weighted by V_ij
   parallelFor(nw, [&](int64_t w) {
     const size_t i = static_cast<size_t>(nc + w);
     const Vec3 vi = p.v[i];
@@ -186,7 +160,8 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
       if (!isWater(p.phase[j])) continue;
       const Vec3 r = p.xPred[i] - p.xPred[j];
       const float h = pairRadius(p.radius[i], p.radius[j]);
-      const float vol = p.mass[j] / std::max(s.density[j], 1e-3f);
+      // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
+      const float vol = 2.0f * p.mass[j] / std::max(s.density[i] + s.density[j], 1e-3f);
       const Vec3 vij = p.v[j] - vi;
       blend += vol * poly6(r.squaredNorm(), h) * vij;
       omega += vol * vij.cross(spikyGrad(r, h));

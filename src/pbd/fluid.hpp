@@ -5,6 +5,7 @@
 #include <soak/state.hpp>
 
 #include "grid/grid.hpp"
+#include "pbd/boundary.hpp"
 #include "world/colliders.hpp"
 
 #include <vector>
@@ -19,15 +20,12 @@ struct FluidScratch {
   std::vector<Vec3> vorticity;     // 1/s, omega_i
   std::vector<Vec3> vNew;          // m/s, velocities after XSPH
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
+  std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
 };
 
 // Akinci volume of each cloth particle, V_b = 1 / sum_k W_bk over the same piece (Eq. 10), and
 // its boundary mass Psi_b = rho0 V_b
 void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLists& nb, FluidScratch& s);
-
-// fraction of the kernel's mass lying beyond a plane at signed distance d (m) from the particle:
-// the continuous limit of a wall of Akinci boundary particles. Also its derivative wrt d.
-float wallKernelFraction(float d, float h, float* dFraction);
 
 // the PBF density constraint (Eq. 6-7), `iterations` Jacobi iterations on p.xPred; cloth particles
 // are moved by the boundary reaction (two-way coupling)

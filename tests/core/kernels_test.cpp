@@ -1,5 +1,5 @@
 #include "core/kernels.hpp"
-#include "pbd/fluid.hpp"
+#include "pbd/boundary.hpp"
 
 #include <gtest/gtest.h>
 

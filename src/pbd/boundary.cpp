@@ -1,0 +1,65 @@
+#include "pbd/boundary.hpp"
+
+#include "world/container.hpp"
+
+#include <cmath>
+
+namespace soak {
+
+void boundaryParts(const Model& model, const std::vector<ColliderPose>& poses, std::vector<BoundaryPart>& parts) {
+  parts.clear();
+  for (size_t c = 0; c < model.colliders.size(); ++c) {
+    const Collider& col = model.colliders[c];
+    if (col.shape != ColliderShape::Container) {
+      parts.push_back({col, poses[c]});
+      continue;
+    }
+    // an open container is concave: its walls are separate convex parts
+    Vec3 centers[kContainerWalls], halves[kContainerWalls];
+    containerWalls(col, centers, halves);
+    for (int k = 0; k < kContainerWalls; ++k) {
+      BoundaryPart part{col, poses[c]};
+      part.shape.shape = ColliderShape::Box;
+      part.shape.halfExtents = halves[k];
+      part.pose.translation = poses[c].translation + poses[c].rotation * centers[k];
+      parts.push_back(part);
+    }
+  }
+}
+
+float wallKernelFraction(float d, float h, float* dFraction) {
+  const float ad = std::fabs(d);
+  if (ad >= h) {
+    if (dFraction) *dFraction = 0.0f;
+    return d > 0.0f ? 0.0f : 1.0f;
+  }
+  const double hh = h, z = ad, h2 = hh * hh;
+  auto antiderivative = [&](double t) {
+    const double t2 = t * t;
+    return h2 * h2 * h2 * h2 * t - 4.0 / 3.0 * h2 * h2 * h2 * t2 * t + 6.0 / 5.0 * h2 * h2 * t2 * t2 * t -
+           4.0 / 7.0 * h2 * t2 * t2 * t2 * t + t2 * t2 * t2 * t2 * t / 9.0;
+  };
+  const double k = 315.0 / (256.0 * std::pow(hh, 9));  // K pi / 4 with K = 315 / (64 pi h^9)
+  const double beyond = k * (antiderivative(hh) - antiderivative(z));
+  const double q = h2 - z * z;
+  if (dFraction) *dFraction = static_cast<float>(-k * q * q * q * q);  // the same on both sides
+  return static_cast<float>(d >= 0.0f ? beyond : 1.0 - beyond);
+}
+
+float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, float h, Vec3* gradient) {
+  float empty = 1.0f;  // prod (1 - phi_k)
+  Vec3 gradEmpty = Vec3::Zero();
+  for (const BoundaryPart& part : parts) {
+    Vec3 n;
+    const float d = colliderDistance(part.shape, part.pose, x, &n);
+    if (d >= h) continue;
+    float dphi = 0.0f;
+    const float keep = 1.0f - wallKernelFraction(d, h, &dphi);
+    gradEmpty = gradEmpty * keep - empty * dphi * n;  // product rule on prod (1 - phi_k)
+    empty *= keep;
+  }
+  if (gradient) *gradient = -gradEmpty;
+  return 1.0f - empty;
+}
+
+}  // namespace soak

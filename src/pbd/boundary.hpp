@@ -1,0 +1,30 @@
+// rigid colliders as boundaries of the water's density: the continuous limit of Akinci et al. 2012's
+// boundary particles. Each convex part of a collider contributes the fraction of the kernel's mass
+// that lies inside it (the half-space integral at the part's distance); parts combine as a union,
+// 1 - prod(1 - phi_k), so water in a corner sees both walls.
+#pragma once
+#include <soak/model.hpp>
+
+#include "world/colliders.hpp"
+
+#include <vector>
+
+namespace soak {
+
+// a convex solid the density sees: a collider or one wall of a container, with its world pose
+struct BoundaryPart {
+  Collider shape;
+  ColliderPose pose;
+};
+
+// the convex parts of every collider at the given poses
+void boundaryParts(const Model& model, const std::vector<ColliderPose>& poses, std::vector<BoundaryPart>& parts);
+
+// fraction of the kernel's mass beyond a plane at signed distance d (m): (K pi / 4) int_d^h (h^2 - z^2)^4 dz
+// for poly6; dFraction receives its derivative wrt d
+float wallKernelFraction(float d, float h, float* dFraction);
+
+// the solid fraction phi of the kernel of a particle at x with support h, and its gradient wrt x
+float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, float h, Vec3* gradient);
+
+}  // namespace soak

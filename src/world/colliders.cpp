@@ -1,0 +1,212 @@
+// rigid colliders: keyframed poses, exact signed distance functions, contact projection with
+// friction, restitution. Shapes live in the collider's local frame (see model.hpp).
+#include "world/colliders.hpp"
+
+#include "world/container.hpp"
+
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+// rotation part of q1 * q0^-1 as a world-frame rotation vector (axis * angle), shortest way round
+Vec3 rotationVector(const Quat& q0, const Quat& q1) {
+  Quat rel = q1.normalized() * q0.normalized().conjugate();
+  if (rel.w() < 0.0f) rel.coeffs() = -rel.coeffs();
+  const Vec3 im = rel.vec();
+  const float s = im.norm();
+  // angle = 2 atan2(|v|, w); at small angles angle / |v| -> 2
+  if (s < 1e-12f) return 2.0f * im;
+  return im * (2.0f * std::atan2(s, rel.w()) / s);
+}
+
+// exact sdf of an axis-aligned box of half extents h centred at c (Quilez), with its gradient
+float boxDistance(const Vec3& p, const Vec3& c, const Vec3& h, Vec3* n) {
+  const Vec3 r = p - c;
+  const Vec3 q = r.cwiseAbs() - h;
+  const Vec3 out = q.cwiseMax(0.0f);
+  const float outLen = out.norm();
+  if (outLen > 0.0f) {
+    // outside: gradient points from the nearest box point to p
+    for (int a = 0; a < 3; ++a) (*n)[a] = r[a] < 0.0f ? -out[a] / outLen : out[a] / outLen;
+    return outLen;
+  }
+  // inside (or on the surface): the nearest face is the axis of largest q; ties take the lower axis
+  int axis = 0;
+  if (q[1] > q[axis]) axis = 1;
+  if (q[2] > q[axis]) axis = 2;
+  *n = Vec3::Zero();
+  (*n)[axis] = r[axis] < 0.0f ? -1.0f : 1.0f;
+  return q[axis];
+}
+
+float localDistance(const Collider& c, const Vec3& p, Vec3* n) {
+  switch (c.shape) {
+    case ColliderShape::Plane:
+      *n = Vec3(0, 1, 0);
+      return p.y();
+    case ColliderShape::Sphere: {
+      const float len = p.norm();
+      *n = len > 0.0f ? Vec3(p / len) : Vec3(0, 1, 0);
+      return len - c.radius;
+    }
+    case ColliderShape::Capsule: {
+      // distance to the segment (0, +-halfHeight, 0) minus the radius
+      const Vec3 onAxis(0.0f, std::clamp(p.y(), -c.halfHeight, c.halfHeight), 0.0f);
+      const Vec3 r = p - onAxis;
+      const float len = r.norm();
+      *n = len > 0.0f ? Vec3(r / len) : Vec3(1, 0, 0);
+      return len - c.radius;
+    }
+    case ColliderShape::Box:
+      return boxDistance(p, Vec3::Zero(), c.halfExtents, n);
+    case ColliderShape::Container: {
+      // open-top box: union (min) of a bottom slab and four side walls (world/container.hpp)
+      Vec3 centers[kContainerWalls], halves[kContainerWalls];
+      containerWalls(c, centers, halves);
+      float best = boxDistance(p, centers[0], halves[0], n);
+      for (int k = 1; k < kContainerWalls; ++k) {
+        Vec3 nk;
+        const float dk = boxDistance(p, centers[k], halves[k], &nk);
+        if (dk < best) {
+          best = dk;
+          *n = nk;
+        }
+      }
+      return best;
+    }
+  }
+  *n = Vec3(0, 1, 0);
+  return p.y();
+}
+
+// friction fraction of a particle of `phase` against collider c
+float frictionFraction(const Model& model, const Collider& c, int32_t phase) {
+  float mu = c.friction;
+  if (!isWater(phase)) {
+    const int k = clothPiece(phase);
+    if (k >= 0 && k < static_cast<int>(model.pieces.size()))
+      mu = 0.5f * (c.friction + model.pieces[k].material.friction);
+  }
+  return std::clamp(mu, 0.0f, 1.0f);
+}
+
+}  // namespace
+
+ColliderPose colliderPose(const Collider& c, double t) {
+  ColliderPose pose;
+  if (c.keys.empty()) return pose;
+  const auto& keys = c.keys;
+  if (keys.size() == 1 || t < keys.front().time) {
+    pose.translation = keys.front().translation;
+    pose.rotation = keys.front().rotation.normalized();
+    return pose;
+  }
+  if (t >= keys.back().time) {
+    pose.translation = keys.back().translation;
+    pose.rotation = keys.back().rotation.normalized();
+    return pose;
+  }
+  // first key strictly after t; the segment is [k - 1, k] with time0 <= t < time1, so the first
+  // key already moves with its segment's velocity
+  const auto it = std::upper_bound(keys.begin(), keys.end(), t,
+                                   [](double tt, const Keyframe& k) { return tt < k.time; });
+  const Keyframe& k1 = *it;
+  const Keyframe& k0 = *(it - 1);
+  const double span = static_cast<double>(k1.time) - static_cast<double>(k0.time);
+  if (span <= 0.0) {
+    pose.translation = k1.translation;
+    pose.rotation = k1.rotation.normalized();
+    return pose;
+  }
+  const float s = static_cast<float>((t - k0.time) / span);
+  const Quat q0 = k0.rotation.normalized();
+  const Quat q1 = k1.rotation.normalized();
+  pose.translation = (1.0f - s) * k0.translation + s * k1.translation;
+  pose.rotation = q0.slerp(s, q1).normalized();
+  pose.linearVelocity = (k1.translation - k0.translation) / static_cast<float>(span);
+  pose.angularVelocity = rotationVector(q0, q1) / static_cast<float>(span);
+  return pose;
+}
+
+float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal) {
+  const Vec3 local = pose.rotation.conjugate() * (p - pose.translation);
+  Vec3 nLocal;
+  const float d = localDistance(c, local, &nLocal);
+  if (normal) *normal = pose.rotation * nLocal;
+  return d;
+}
+
+float contactMargin(const Model& model, int32_t phase) {
+  if (isWater(phase)) return 0.5f * model.water.spacing;
+  const int k = clothPiece(phase);
+  if (k < 0 || k >= static_cast<int>(model.pieces.size())) return 1e-4f;
+  return std::max(0.5f * model.pieces[k].material.thickness, 1e-4f);
+}
+
+// Contact and friction model (position level, once per substep):
+//   d = sdf(x*) - margin; if d < 0 then x* <- x* - d n            (push out to the margin)
+//   dx = (x* - x) - v_col(x*) dt                                   (slip relative to the collider)
+//   x* <- x* - mu (dx - (dx.n) n)                                  (remove the fraction mu of the
+//                                                                  tangential slip)
+// mu = collider.friction for water, 0.5 (collider.friction + cloth material friction) for cloth.
+// mu = 1 makes the particle move tangentially with the collider surface, mu = 0 lets it slide.
+void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
+                      std::vector<Vec3>& contactNormal) {
+  const int64_t n = static_cast<int64_t>(p.size());
+  contactNormal.assign(p.size(), Vec3::Zero());
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  if (numColliders == 0) return;
+  parallelFor(n, [&](int64_t i) {
+    if (!(p.invMass[i] > 0.0f)) return;
+    const float margin = contactMargin(model, p.phase[i]);
+    Vec3 xp = p.xPred[i];
+    for (size_t c = 0; c < numColliders; ++c) {
+      const Collider& col = model.colliders[c];
+      Vec3 nrm;
+      const float d = colliderDistance(col, poses[c], xp, &nrm) - margin;
+      if (d >= 0.0f) continue;
+      xp -= d * nrm;
+      const Vec3 dx = (xp - p.x[i]) - poses[c].velocityAt(xp) * dt;
+      const Vec3 tangential = dx - dx.dot(nrm) * nrm;
+      xp -= frictionFraction(model, col, p.phase[i]) * tangential;
+      contactNormal[i] = nrm;
+    }
+    p.xPred[i] = xp;
+  });
+}
+
+// the collider that made the contact is re-found as the one closest to x* (smallest distance minus
+// margin, lowest index on ties), so no per-particle collider index has to be carried
+void applyColliderRestitution(const Model& model, const std::vector<ColliderPose>& poses,
+                              const std::vector<Vec3>& contactNormal, Particles& p) {
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  if (numColliders == 0) return;
+  const int64_t n = static_cast<int64_t>(std::min(p.size(), contactNormal.size()));
+  parallelFor(n, [&](int64_t i) {
+    const Vec3& nrm = contactNormal[i];
+    if (nrm.squaredNorm() == 0.0f || !(p.invMass[i] > 0.0f)) return;
+    const Vec3 xp = p.xPred[i];
+    size_t best = 0;
+    float bestDist = colliderDistance(model.colliders[0], poses[0], xp, nullptr);
+    for (size_t c = 1; c < numColliders; ++c) {
+      const float d = colliderDistance(model.colliders[c], poses[c], xp, nullptr);
+      if (d < bestDist) {
+        bestDist = d;
+        best = c;
+      }
+    }
+    const Vec3 vCol = poses[best].velocityAt(xp);
+    const float vn = (p.v[i] - vCol).dot(nrm);
+    if (vn >= 0.0f) return;
+    // new relative normal velocity = -e vn
+    const float e = std::clamp(model.colliders[best].restitution, 0.0f, 1.0f);
+    p.v[i] -= (1.0f + e) * vn * nrm;
+  });
+}
+
+}  // namespace soak

@@ -1,0 +1,117 @@
+// water emitters: a block of water on a cubic lattice (Fig. 3) and a nozzle jet of evenly spaced
+// discs (Fig. 1). Serial: emission is cheap, and the order of new particles must be deterministic.
+#include "world/emitters.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+// appends one water particle unless the cap is reached; returns whether it was added
+bool addWater(const Model& model, State& state, const Vec3& x, const Vec3& v) {
+  if (state.particles.size() >= static_cast<size_t>(std::max(model.solver.maxParticles, 0))) return false;
+  const float m = model.water.particleMass;
+  state.particles.add(kWaterPhase, state.nextId++, m, model.water.supportRadius, x, v);
+  state.ledger.emitted += m;
+  return true;
+}
+
+// number of lattice sites of spacing s that fit in [lo, hi] starting at lo + s/2
+int latticeCount(float lo, float hi, float s) {
+  const double extent = static_cast<double>(hi) - static_cast<double>(lo);
+  if (extent <= 0.0) return 0;
+  // tolerance so that an extent of exactly n spacings in float gives n sites
+  return static_cast<int>(std::floor(extent / s + 1e-4));
+}
+
+size_t emitBlock(const Model& model, State& state, const Emitter& e) {
+  const float s = model.water.spacing;
+  const int nx = latticeCount(e.boxMin.x(), e.boxMax.x(), s);
+  const int ny = latticeCount(e.boxMin.y(), e.boxMax.y(), s);
+  const int nz = latticeCount(e.boxMin.z(), e.boxMax.z(), s);
+  const Vec3 first = e.boxMin + Vec3::Constant(0.5f * s);
+  size_t created = 0;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const Vec3 x = first + s * Vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k));
+        if (!addWater(model, state, x, e.velocity)) return created;
+        ++created;
+      }
+  return created;
+}
+
+// an orthonormal pair spanning the plane orthogonal to unit d, built from the world axis least
+// aligned with d so the lattice orientation is fixed for a given direction
+void discBasis(const Vec3& d, Vec3* u, Vec3* w) {
+  const Vec3 a = d.cwiseAbs();
+  Vec3 helper = Vec3::UnitX();
+  if (a.y() < a.x() && a.y() <= a.z()) helper = Vec3::UnitY();
+  else if (a.z() < a.x() && a.z() < a.y()) helper = Vec3::UnitZ();
+  *u = d.cross(helper).normalized();
+  *w = d.cross(*u);
+}
+
+// the jet travels speed * (overlap of [t, t + dt) with [start, end)); a disc leaves the nozzle each
+// time the travelled length crosses a multiple of the spacing, placed where it would be now, so the
+// discs stay one spacing apart whatever dt is. Each disc is a square lattice (the cubic lattice of a
+// block, so the jet has rest density) clipped to the nozzle radius.
+size_t emitJet(const Model& model, State& state, const Emitter& e, EmitterState& es, double t, float dt) {
+  const double t0 = std::max(t, static_cast<double>(e.start));
+  const double t1 = std::min(t + static_cast<double>(dt), static_cast<double>(e.end));
+  if (t1 >= static_cast<double>(e.end)) es.done = true;
+  if (!(t1 > t0) || !(e.speed > 0.0f)) return 0;
+  const double s = model.water.spacing;
+  const double before = es.emittedLength;
+  const double after = before + static_cast<double>(e.speed) * (t1 - t0);
+  es.emittedLength = after;
+
+  Vec3 d = e.direction;
+  d = d.norm() > 0.0f ? Vec3(d.normalized()) : Vec3(0, -1, 0);
+  Vec3 u, w;
+  discBasis(d, &u, &w);
+  const Vec3 vel = e.speed * d;
+  const int n = static_cast<int>(std::floor(e.radius / s));
+  const double r2 = static_cast<double>(e.radius) * e.radius / (s * s) + 1e-6;
+
+  size_t created = 0;
+  const int64_t kFirst = static_cast<int64_t>(std::floor(before / s)) + 1;
+  const int64_t kLast = static_cast<int64_t>(std::floor(after / s));
+  for (int64_t k = kFirst; k <= kLast; ++k) {
+    const Vec3 centre = e.origin + static_cast<float>(after - static_cast<double>(k) * s) * d;
+    for (int j = -n; j <= n; ++j)
+      for (int i = -n; i <= n; ++i) {
+        if (static_cast<double>(i * i + j * j) > r2) continue;
+        const Vec3 x = centre + static_cast<float>(s) * (static_cast<float>(i) * u + static_cast<float>(j) * w);
+        if (!addWater(model, state, x, vel)) return created;
+        ++created;
+      }
+  }
+  return created;
+}
+
+}  // namespace
+
+size_t emitWater(const Model& model, State& state, double t, float dt) {
+  if (state.emitters.size() < model.emitters.size()) state.emitters.resize(model.emitters.size());
+  size_t created = 0;
+  for (size_t k = 0; k < model.emitters.size(); ++k) {
+    const Emitter& e = model.emitters[k];
+    EmitterState& es = state.emitters[k];
+    if (es.done) continue;
+    if (e.kind == EmitterKind::Block) {
+      // due once its start time is reached within this step (an overdue block is emitted now)
+      if (static_cast<double>(e.start) < t + static_cast<double>(dt) || (t == 0.0 && e.start <= 0.0f)) {
+        created += emitBlock(model, state, e);
+        es.done = true;
+      }
+    } else {
+      created += emitJet(model, state, e, es, t, dt);
+    }
+  }
+  return created;
+}
+
+}  // namespace soak

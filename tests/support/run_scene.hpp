@@ -1,0 +1,35 @@
+// helpers for tests that run whole scenes
+#pragma once
+#include <soak/scene.hpp>
+#include <soak/step.hpp>
+
+#include "core/parallel.hpp"
+
+#include <string>
+
+namespace soak::testing {
+
+inline Scene sceneFromJson(const std::string& json, const std::vector<std::string>& overrides = {}) {
+  return loadSceneFromString(json, "<test>", SOAK_SOURCE_DIR, overrides);
+}
+
+inline Scene sceneFromFile(const std::string& relative, const std::vector<std::string>& overrides = {}) {
+  return loadScene(std::string(SOAK_SOURCE_DIR) + "/" + relative, overrides);
+}
+
+// runs `steps` steps of the scene's dt; returns the summed statistics
+inline StepStats runSteps(Scene& scene, int steps) {
+  WorkspacePtr ws = makeWorkspace();
+  StepStats total;
+  for (int s = 0; s < steps; ++s) step(scene.model, scene.state, *ws, scene.model.solver.dt, total);
+  return total;
+}
+
+inline double totalWaterMass(const Scene& scene) {
+  double m = 0.0;
+  const Particles& p = scene.state.particles;
+  for (size_t i = static_cast<size_t>(scene.model.numCloth); i < p.size(); ++i) m += p.mass[i];
+  return m;
+}
+
+}  // namespace soak::testing
