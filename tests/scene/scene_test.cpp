@@ -1,0 +1,407 @@
+// scene loading: shipped scenes load and match the paper's figures, defaults are Table 1, overrides
+// apply, pins land on the right particles, and every documented error names the file and JSON path
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "world/colliders.hpp"
+#include "world/emitters.hpp"
+
+namespace soak {
+namespace {
+
+namespace fs = std::filesystem;
+
+// a small valid scene: one 4 x 3 rectangle, one block emitter
+const char* kSmall = R"({
+  "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.3, 0.2],
+                                      "resolution": [4, 3]}}],
+  "emitters": [{"type": "block", "min": [-0.05, 1.2, -0.05], "max": [0.05, 1.3, 0.05]}]
+})";
+
+Scene fromString(const std::string& text, const std::vector<std::string>& overrides = {},
+                 const std::string& baseDir = ".") {
+  return loadSceneFromString(text, "test.json", baseDir, overrides);
+}
+
+// the message of the soak::Error thrown by loading `text`, or "" when it loads
+std::string loadError(const std::string& text, const std::vector<std::string>& overrides = {},
+                      const std::string& baseDir = ".") {
+  try {
+    fromString(text, overrides, baseDir);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// the error of loading kSmall with one "path=value" override applied
+std::string errorWith(const std::string& override_) { return loadError(kSmall, {override_}); }
+
+// a fresh directory under the system temp dir, removed at the end of the test
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path = fs::temp_directory_path() / ("soak_scene_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path / name) << text;
+    return (path / name).string();
+  }
+};
+
+#define EXPECT_HAS(haystack, needle) EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+TEST(SceneFiles, EveryShippedSceneLoadsWithADescription) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(SOAK_SOURCE_DIR) / "scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scene s = loadScene(entry.path().string());
+    EXPECT_FALSE(s.description.empty());
+    EXPECT_EQ(s.name, entry.path().stem().string());
+    EXPECT_EQ(s.state.particles.size(), size_t(s.model.numCloth));
+    EXPECT_EQ(s.state.emitters.size(), s.model.emitters.size());
+    ++count;
+  }
+  EXPECT_GE(count, 3);
+}
+
+TEST(SceneFiles, Fig3aHasThePapersParticleCounts) {
+  Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/fig3a_cube_on_cloth.json");
+  EXPECT_EQ(s.model.numCloth, 14400);  // Table 2: 14.4k cloth particles
+  int pinned = 0;
+  for (uint8_t p : s.model.clothPinned) pinned += p;
+  EXPECT_EQ(pinned, 4);
+  const size_t created = emitWater(s.model, s.state, 0.0, s.model.solver.dt);
+  EXPECT_EQ(created, 13824u);  // 24^3 water particles (Table 2: 13.8k)
+  float lowest = 1e9f, clothY = s.model.clothRestPosition[0].y();
+  for (size_t i = size_t(s.model.numCloth); i < s.state.particles.size(); ++i)
+    lowest = std::min(lowest, s.state.particles.x[i].y());
+  EXPECT_NEAR(lowest - clothY, 0.15f, 0.02f);  // the cube starts ~0.15 m above the cloth
+}
+
+TEST(SceneFiles, DamBreakWaterStartsInsideTheContainer) {
+  Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/dam_break.json");
+  ASSERT_EQ(s.model.colliders.size(), 1u);
+  EXPECT_EQ(s.model.numCloth, 0);
+  const size_t created = emitWater(s.model, s.state, 0.0, s.model.solver.dt);
+  EXPECT_EQ(created, 20u * 30u * 20u);
+  const ColliderPose pose = colliderPose(s.model.colliders[0], 0.0);
+  for (size_t i = 0; i < s.state.particles.size(); ++i) {
+    Vec3 n;
+    // outside the walls' solid by at least the water's contact margin (half a spacing), up to rounding
+    ASSERT_GE(colliderDistance(s.model.colliders[0], pose, s.state.particles.x[i], &n), 0.5f * 0.02f - 1e-5f)
+        << "particle " << i;
+  }
+}
+
+TEST(SceneDefaults, EqualTable1OfShao2017) {
+  const Scene s = fromString(kSmall);
+  EXPECT_FLOAT_EQ(s.model.solver.dt, 0.015f);
+  EXPECT_FLOAT_EQ(s.model.water.spacing, 0.02f);
+  EXPECT_FLOAT_EQ(s.model.water.supportRadius, 0.04f);
+  EXPECT_FLOAT_EQ(s.model.water.restDensity, 1000.0f);
+  EXPECT_FLOAT_EQ(s.model.water.particleMass, 0.0082f);
+  ASSERT_EQ(s.model.pieces.size(), 1u);
+  EXPECT_FLOAT_EQ(s.model.pieces[0].material.restDensity, 800.0f);
+  EXPECT_FLOAT_EQ(s.model.pieces[0].material.particleMass, 0.0066f);
+  EXPECT_FLOAT_EQ(s.model.solver.gravity.y(), -9.81f);
+  EXPECT_EQ(s.name, "test");  // the stem of the source name
+  EXPECT_EQ(s.output.frames, 100);
+  EXPECT_TRUE(s.output.clothObj && s.output.clothPly && s.output.water);
+}
+
+TEST(SceneBuild, ClothParticlesFollowTheContract) {
+  const Scene s = fromString(R"({
+    "cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.2], "resolution": [4, 3]}},
+              {"name": "b", "mesh": {"type": "rectangle", "center": [0, 2, 0], "size": [0.1, 0.1], "resolution": [2, 2]},
+               "material": {"particleMass": 0.01}, "pin": {"vertices": [1]}}]})");
+  const Particles& p = s.state.particles;
+  ASSERT_EQ(p.size(), 16u);
+  EXPECT_EQ(s.model.numCloth, 16);
+  EXPECT_EQ(s.state.nextId, 16u);
+  EXPECT_EQ(s.model.pieces[0].name, "cloth0");
+  EXPECT_EQ(s.model.pieces[1].name, "b");
+  for (size_t i = 0; i < p.size(); ++i) {
+    const bool second = i >= 12;
+    EXPECT_EQ(p.phase[i], second ? 2 : 1);
+    EXPECT_EQ(p.id[i], uint32_t(i));
+    EXPECT_FLOAT_EQ(p.mass[i], second ? 0.01f : 0.0066f);
+    EXPECT_FLOAT_EQ(p.radius[i], 0.04f);
+    EXPECT_TRUE(p.x[i] == s.model.clothRestPosition[i] && p.xPred[i] == p.x[i]);
+    EXPECT_TRUE(p.v[i].isZero());
+    const bool pinned = i == 13;
+    EXPECT_EQ(s.model.clothPinned[i], pinned ? 1 : 0);
+    EXPECT_FLOAT_EQ(p.invMass[i], pinned ? 0.0f : 1.0f / p.mass[i]);
+  }
+}
+
+TEST(SceneBuild, RectangleCornersArePinnedAtTheRightParticles) {
+  // a tilted rectangle: u along z, v along (1, 1, 0)/sqrt 2, so every corner sits at a distinct place
+  const Scene s = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "center": [1, 2, 3], "size": [0.6, 0.4],
+      "resolution": [7, 5], "axisU": [0, 0, 2], "axisV": [1, 1, 0]}, "pin": {"corners": [1, 2]}}]})");
+  const Vec3 c(1, 2, 3), u(0, 0, 1), v = Vec3(1, 1, 0).normalized();
+  const Vec3 corner1 = c + 0.3f * u - 0.2f * v, corner2 = c - 0.3f * u + 0.2f * v;
+  int found = 0;
+  for (int i = 0; i < s.model.numCloth; ++i) {
+    const Vec3& x = s.state.particles.x[size_t(i)];
+    const bool atCorner = (x - corner1).norm() < 1e-5f || (x - corner2).norm() < 1e-5f;
+    EXPECT_EQ(s.state.particles.invMass[size_t(i)] == 0.0f, atCorner) << "particle " << i;
+    found += atCorner;
+  }
+  EXPECT_EQ(found, 2);
+}
+
+TEST(SceneBuild, PinRegionSelectsVerticesByRestPosition) {
+  // 5 x 3 grid over x in [-0.2, 0.2], z in [-0.1, 0.1]: the region x >= 0.15 holds one column (3)
+  const Scene s = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.4, 0.2], "resolution": [5, 3]},
+      "pin": {"region": {"min": [0.15, -1, -1], "max": [1, 1, 1]}}}]})");
+  int pinned = 0;
+  for (int i = 0; i < s.model.numCloth; ++i) {
+    const bool inRegion = s.model.clothRestPosition[size_t(i)].x() >= 0.15f;
+    EXPECT_EQ(s.model.clothPinned[size_t(i)] == 1, inRegion);
+    pinned += s.model.clothPinned[size_t(i)];
+  }
+  EXPECT_EQ(pinned, 3);
+}
+
+TEST(SceneBuild, ObjMeshIsScaledRotatedTranslatedRelativeToTheSceneFile) {
+  TempDir dir;
+  dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  const std::string path = dir.write("scene.json", R"({"cloth": [{"mesh": {"type": "obj", "path": "quad.obj",
+      "scale": 2, "translate": [0, 0, 5], "rotate": {"axis": [0, 0, 1], "degrees": 90}},
+      "pin": {"vertices": [2]}}]})");
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.model.numCloth, 4);
+  // vertex 1 (1, 0, 0) -> scale (2, 0, 0) -> rotate 90 deg about z (0, 2, 0) -> translate (0, 2, 5)
+  EXPECT_TRUE(s.model.clothRestPosition[1].isApprox(Vec3(0, 2, 5), 1e-5f));
+  EXPECT_EQ(s.model.clothPinned[2], 1);
+  EXPECT_EQ(s.name, "scene");
+}
+
+TEST(SceneBuild, CollidersAndEmittersAreRead) {
+  const Scene s = fromString(R"({
+    "colliders": [
+      {"type": "plane", "normal": [1, 1, 0], "position": [0, -1, 0]},
+      {"type": "capsule", "radius": 0.1, "halfHeight": 0.3, "friction": 0.7, "restitution": 0.2,
+       "rotation": {"axis": [1, 0, 0], "degrees": 90}},
+      {"type": "box", "halfExtents": [1, 2, 3],
+       "keyframes": [{"time": 0, "position": [0, 0, 0]}, {"time": 2, "position": [1, 0, 0]}]}],
+    "emitters": [{"name": "hose", "type": "jet", "origin": [0, 1, 0], "direction": [0, 0, -3], "speed": 4,
+                  "radius": 0.03, "start": 0.5, "end": 2}]})");
+  const auto& c = s.model.colliders;
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[0].shape, ColliderShape::Plane);
+  ASSERT_EQ(c[0].keys.size(), 1u);
+  EXPECT_TRUE((c[0].keys[0].rotation * Vec3::UnitY()).isApprox(Vec3(1, 1, 0).normalized(), 1e-5f));
+  EXPECT_TRUE(c[0].keys[0].translation.isApprox(Vec3(0, -1, 0)));
+  EXPECT_EQ(c[1].shape, ColliderShape::Capsule);
+  EXPECT_FLOAT_EQ(c[1].radius, 0.1f);
+  EXPECT_FLOAT_EQ(c[1].halfHeight, 0.3f);
+  EXPECT_FLOAT_EQ(c[1].friction, 0.7f);
+  EXPECT_FLOAT_EQ(c[1].restitution, 0.2f);
+  EXPECT_TRUE((c[1].keys[0].rotation * Vec3::UnitY()).isApprox(Vec3(0, 0, 1), 1e-5f));
+  ASSERT_EQ(c[2].keys.size(), 2u);
+  EXPECT_FLOAT_EQ(c[2].keys[1].time, 2.0f);
+  EXPECT_TRUE(c[2].halfExtents.isApprox(Vec3(1, 2, 3)));
+  ASSERT_EQ(s.model.emitters.size(), 1u);
+  const Emitter& e = s.model.emitters[0];
+  EXPECT_EQ(e.kind, EmitterKind::Jet);
+  EXPECT_EQ(e.name, "hose");
+  EXPECT_TRUE(e.direction.isApprox(Vec3(0, 0, -1)));  // normalised
+  EXPECT_FLOAT_EQ(e.start, 0.5f);
+  EXPECT_FLOAT_EQ(e.end, 2.0f);
+  EXPECT_EQ(s.state.particles.size(), 0u);  // emitters do not run at load
+}
+
+TEST(SceneOverrides, ChangeValuesBeforeValidation) {
+  const Scene s = fromString(kSmall, {"solver.substeps=3", "cloth.0.material.thickness=0.02", "water.tensile.k=0.25",
+                                      "output.water=false", "name=my run", "description=\"quoted\"",
+                                      "cloth.0.pin.corners=[0, 3]"});
+  EXPECT_EQ(s.model.solver.substeps, 3);
+  EXPECT_FLOAT_EQ(s.model.pieces[0].material.thickness, 0.02f);
+  EXPECT_FLOAT_EQ(s.model.water.tensileK, 0.25f);
+  EXPECT_FALSE(s.output.water);
+  EXPECT_EQ(s.name, "my run");  // not JSON: taken as a string
+  EXPECT_EQ(s.description, "quoted");
+  int pinned = 0;
+  for (uint8_t p : s.model.clothPinned) pinned += p;
+  EXPECT_EQ(pinned, 2);
+  // an override is validated like the file itself
+  EXPECT_HAS(errorWith("solver.substeps=0"), "test.json: at solver.substeps: expected an integer >= 1, got 0");
+}
+
+TEST(SceneErrors, BadOverridesNameTheOverride) {
+  EXPECT_HAS(errorWith("solver.substeps"), "test.json: at override 'solver.substeps': expected \"path=value\"");
+  EXPECT_HAS(errorWith("cloth.3.name=x"), "at override 'cloth.3.name=x': index 3 is past the end of 'cloth' (1 elements)");
+  EXPECT_HAS(errorWith("cloth.0.name.x=1"), "at override 'cloth.0.name.x=1': 'cloth.0.name' is a string, it has no key 'x'");
+  EXPECT_HAS(errorWith("cloth.first=1"), "'cloth' is an array: expected an index, got 'first'");
+  EXPECT_HAS(errorWith("solver..dt=1"), "at override 'solver..dt=1': expected a path of non-empty components");
+  EXPECT_HAS(errorWith("colliders.0.type=box"), "index 0 is past the end of 'colliders'");
+}
+
+TEST(SceneErrors, UnknownKeysAtTopLevelAndNested) {
+  EXPECT_HAS(errorWith("solvr.dt=1"), "test.json: at solvr: unknown key 'solvr' (known: name, description, solver,");
+  EXPECT_HAS(errorWith("solvr.dt=1"), "did you mean 'solver'?");
+  EXPECT_HAS(errorWith("solver.substep=2"), "test.json: at solver.substep: unknown key 'substep' (known: dt, substeps,");
+  EXPECT_HAS(errorWith("cloth.0.material.thicknes=0.1"), "at cloth[0].material.thicknes: unknown key 'thicknes'");
+  EXPECT_HAS(errorWith("cloth.0.mesh.path=a.obj"),
+             "at cloth[0].mesh.path: 'path' is not a key of a rectangle mesh (keys of a rectangle mesh: type, center,");
+}
+
+TEST(SceneErrors, WrongTypeAndOutOfRange) {
+  EXPECT_HAS(errorWith("solver.dt=fast"), "test.json: at solver.dt: expected a number > 0, got the string \"fast\"");
+  EXPECT_HAS(errorWith("solver.dt=0"), "at solver.dt: expected a number > 0, got 0");
+  EXPECT_HAS(errorWith("solver.gravity=[0, -9.81]"), "at solver.gravity: expected an array of 3 numbers, got [0,-9.81]");
+  EXPECT_HAS(errorWith("cloth.0.material.friction=1.5"), "at cloth[0].material.friction: expected a number in [0, 1], got 1.5");
+  EXPECT_HAS(errorWith("cloth.0.mesh.resolution=[1, 3]"), "at cloth[0].mesh.resolution[0]: expected an integer >= 2, got 1");
+  EXPECT_HAS(errorWith("solver.fluidIterations=0"), "at solver.fluidIterations: expected an integer >= 1, got 0");
+  EXPECT_HAS(errorWith("solver.clothIterations=-1"), "at solver.clothIterations: expected an integer >= 0, got -1");
+  EXPECT_HAS(errorWith("output.water=1"), "at output.water: expected true or false, got 1");
+  EXPECT_HAS(errorWith("cloth=3"), "test.json: at cloth: expected an array, got 3");
+  EXPECT_HAS(errorWith("cloth.0.mesh.axisV=[0, 0, 0]"), "at cloth[0].mesh.axisV: expected a non-zero direction");
+}
+
+TEST(SceneErrors, BadEnumListsTheAllowedValues) {
+  EXPECT_HAS(loadError(R"({"cloth": [], "emitters": [{"type": "block", "min": [0,0,0], "max": [1,1,1]}],
+                           "colliders": [{"type": "cube"}]})"),
+             "test.json: at colliders[0].type: expected one of \"plane\", \"box\", \"container\", \"sphere\", "
+             "\"capsule\", got the string \"cube\"");
+  EXPECT_HAS(errorWith("emitters.0.type=hose"), "at emitters[0].type: expected one of \"block\", \"jet\"");
+  EXPECT_HAS(errorWith("cloth.0.mesh.type=sphere"), "at cloth[0].mesh.type: expected one of \"rectangle\", \"obj\"");
+}
+
+TEST(SceneErrors, KeysOfOtherTypesAreRefused) {
+  const std::string base = R"({"emitters": [{"type": "block", "min": [0,0,0], "max": [1,1,1]}], "colliders": [)";
+  EXPECT_HAS(loadError(base + R"({"type": "box", "radius": 0.2}]})"),
+             "test.json: at colliders[0].radius: 'radius' is not a key of a box collider");
+  EXPECT_HAS(loadError(base + R"({"type": "sphere", "normal": [0, 1, 0]}]})"),
+             "at colliders[0].normal: 'normal' is not a key of a sphere collider");
+  EXPECT_HAS(errorWith("emitters.0.speed=3"), "at emitters[0].speed: 'speed' is not a key of a block emitter");
+}
+
+TEST(SceneErrors, CrossFieldChecks) {
+  EXPECT_HAS(errorWith("water.supportRadius=0.02"), "at water.supportRadius: expected a number > water.spacing (0.02), got 0.02");
+  EXPECT_HAS(errorWith("solver.domain.max=[1, -20, 1]"), "at solver.domain.max: expected every component greater than");
+  EXPECT_HAS(errorWith("emitters.0.max=[0, 1, 0]"), "at emitters[0].max: expected every component greater than min");
+  EXPECT_HAS(errorWith("emitters.0.min=[-30, 1, 0]"), "at emitters[0]: expected a block inside solver.domain");
+  EXPECT_HAS(errorWith("cloth.0.mesh.axisV=[1, 0.5, 0]"), "at cloth[0].mesh.axisV: expected a direction perpendicular to axisU");
+  const std::string jet = R"({"emitters": [{"type": "jet", "origin": [0, 0, 0], "start": 2, "end": 1}]})";
+  EXPECT_HAS(loadError(jet), "at emitters[0].end: expected a time > start (2 s), got 1");
+  const std::string keys = R"({"cloth": [{"mesh": {"type": "rectangle", "size": [1, 1], "resolution": [2, 2]}}],
+      "colliders": [{"type": "sphere", "position": [0, 0, 0], "keyframes": [{"time": 1}, {"time": 1}]}]})";
+  const std::string keysError = loadError(keys);
+  EXPECT_HAS(keysError, "at colliders[0].keyframes[1].time: expected a time > the previous keyframe's (1 s), got 1");
+  EXPECT_HAS(keysError, "at colliders[0].keyframes: expected either position/rotation or keyframes, got both");
+}
+
+TEST(SceneErrors, EmptySceneAndMissingRequiredKeys) {
+  EXPECT_HAS(loadError(R"({"name": "nothing", "cloth": []})"),
+             "test.json: at (top level): expected at least one cloth piece or emitter, got none");
+  EXPECT_HAS(loadError(R"([1, 2])"), "test.json: at (top level): expected a JSON object at the top level, got [1,2]");
+  EXPECT_HAS(loadError(R"({"cloth": [{"name": "a"}]})"), "at cloth[0].mesh: expected an object, got nothing (the key is required)");
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle", "resolution": [2, 2]}}]})"),
+             "at cloth[0].mesh.size: expected an array of 2 numbers > 0, got nothing (the key is required)");
+}
+
+TEST(SceneErrors, AllErrorsAreReportedTogether) {
+  const std::string msg = loadError(kSmall, {"solver.dt=-1", "water.viscosity=2", "output.frames=0"});
+  EXPECT_HAS(msg, "at solver.dt:");
+  EXPECT_HAS(msg, "at water.viscosity:");
+  EXPECT_HAS(msg, "at output.frames:");
+  EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 2);
+}
+
+TEST(SceneErrors, LongErrorListsAreCut) {
+  std::string many = "[";
+  for (int i = 0; i < 80; ++i) many += (i ? ", " : "") + std::to_string(100 + i);
+  const std::string msg = errorWith("cloth.0.pin.vertices=" + many + "]");
+  EXPECT_HAS(msg, "at cloth[0].pin.vertices[0]: expected an integer in [0, 11], got 100");
+  EXPECT_HAS(msg, "at cloth[0].pin.vertices[49]:");
+  EXPECT_EQ(msg.find("vertices[50]"), std::string::npos);
+  EXPECT_HAS(msg, "test.json: and 30 more errors");
+}
+
+TEST(SceneErrors, PinOutOfRange) {
+  EXPECT_HAS(errorWith("cloth.0.pin.vertices=[0, 12]"),
+             "test.json: at cloth[0].pin.vertices[1]: expected an integer in [0, 11], got 12");
+  EXPECT_HAS(errorWith("cloth.0.pin.corners=[4]"), "at cloth[0].pin.corners[0]: expected an integer in [0, 3], got 4");
+  EXPECT_HAS(errorWith("cloth.0.pin.region={\"min\": [5, 5, 5], \"max\": [6, 6, 6]}"),
+             "at cloth[0].pin.region: expected a box containing at least one vertex");
+}
+
+TEST(SceneErrors, MissingObjNamesThePathItTried) {
+  TempDir dir;
+  const std::string text = R"({"cloth": [{"mesh": {"type": "obj", "path": "nowhere/shirt.obj"}}]})";
+  const std::string msg = loadError(text, {}, dir.path.string());
+  EXPECT_HAS(msg, "test.json: at cloth[0].mesh.path: expected the path of an existing OBJ file, got \"nowhere/shirt.obj\"");
+  EXPECT_HAS(msg, "(tried \"" + (dir.path / "nowhere/shirt.obj").string() + "\")");
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "obj", "path": "a.obj"}, "pin": {"corners": [0]}}]})", {},
+                       (fs::path(SOAK_SOURCE_DIR) / "scenes").string()),
+             "at cloth[0].mesh.path: expected the path of an existing OBJ file");
+}
+
+TEST(SceneErrors, CornersAreOnlyForRectangles) {
+  TempDir dir;
+  dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string text = R"({"cloth": [{"mesh": {"type": "obj", "path": "tri.obj"}, "pin": {"corners": [0]}}]})";
+  EXPECT_HAS(loadError(text, {}, dir.path.string()), "at cloth[0].pin.corners: expected no corners on an obj mesh");
+}
+
+TEST(SceneErrors, NonManifoldObjIsRefusedWithFileAndPath) {
+  TempDir dir;
+  // three triangles share the edge (1, 2): a fin that no cloth can be
+  dir.write("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+  const std::string scene = dir.write("fin.json", R"({"cloth": [{"name": "fin", "mesh": {"type": "obj", "path": "fin.obj"}}]})");
+  try {
+    loadScene(scene);
+    FAIL() << "a non-manifold mesh loaded";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_HAS(msg, scene + ": at cloth[0].mesh");
+    EXPECT_HAS(msg, "shared by 3 triangles");
+  }
+}
+
+TEST(SceneErrors, JsonSyntaxErrorNamesLineAndColumn) {
+  const std::string msg = loadError("{\n  \"solver\": {\n    \"dt\": 0.01,\n  }\n}\n");
+  EXPECT_HAS(msg, "test.json: at line 4, column 3: invalid JSON: syntax error");
+  TempDir dir;
+  const std::string path = dir.write("broken.json", "{\"cloth\": [\n\n  {\"mesh\" {}}\n]}");
+  try {
+    loadScene(path);
+    FAIL() << "broken JSON loaded";
+  } catch (const Error& e) {
+    EXPECT_HAS(std::string(e.what()), path + ": at line 3, column");
+  }
+  // comments are allowed
+  EXPECT_EQ(loadError(std::string("// a comment\n") + kSmall), "");
+}
+
+TEST(SceneErrors, FileErrorsNameTheFile) {
+  TempDir dir;
+  const std::string path = dir.write("bad.json", R"({"cloth": [{"mesh": {"type": "rectangle", "size": [1, 1],
+      "resolution": [2, 2]}, "material": {"thickness": -0.01}}]})");
+  try {
+    loadScene(path);
+    FAIL() << "a negative thickness loaded";
+  } catch (const Error& e) {
+    EXPECT_HAS(std::string(e.what()), path + ": at cloth[0].material.thickness: expected a number > 0, got -0.01");
+  }
+  EXPECT_THROW(loadScene((dir.path / "absent.json").string()), Error);
+}
+
+}  // namespace
+}  // namespace soak
