@@ -80,6 +80,15 @@ struct BendConstraints {
   std::vector<int> colorStart;
 };
 
+// long range attachments (Kim, Chentanez, Müller 2012): a free cloth particle may be at most
+// `length` (its rest path length along the mesh) from each of its anchors, the pinned vertices
+// nearest to it; they make a large pinned cloth hang at any iteration count
+struct Tethers {
+  std::vector<int> start;      // CSR over cloth particles: tethers of i are [start[i], start[i + 1])
+  std::vector<int> anchor;     // pinned particle index
+  std::vector<float> length;   // m
+};
+
 struct Model {
   SolverParams solver;
   WaterParams water;
@@ -96,6 +105,7 @@ struct Model {
   std::vector<int> vertexNeighbors;              // sorted per particle
   StretchConstraints stretch;
   BendConstraints bend;
+  Tethers tethers;
 
   std::vector<Collider> colliders;
   std::vector<Emitter> emitters;

@@ -3,6 +3,7 @@
 
 #include "core/parallel.hpp"
 #include "pbd/integrate.hpp"
+#include "pbd/tethers.hpp"
 #include "pbd/workspace.hpp"
 #include "world/emitters.hpp"
 
@@ -39,6 +40,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
   ms.water += clock.lap();
   solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // stretch Eq. 8, bend Eq. 9
+  solveTethers(model, p);                                                           // long range attachments
   clothSelfCollision(model, p, ws.neighbors, ws.cloth);
   ms.cloth += clock.lap();
   projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "pbd/cloth.hpp"
+#include "pbd/tethers.hpp"
 #include "scene/overrides.hpp"
 #include "scene/reader.hpp"
 
@@ -458,6 +459,7 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   // build: topology is checked by addClothPiece (manifold edges, degenerate triangles)
   for (const ClothSpec& c : cloth)
     addClothPiece(model, c.name, c.mesh, c.material, c.pinned, fmt::format("{}: at {}.mesh", file, c.path));
+  buildTethers(model);
   Particles& p = scene.state.particles;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];

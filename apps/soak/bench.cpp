@@ -1,0 +1,310 @@
+// `soak bench`: times the solver stages on the scenes of bench/benchmarks.json (bench/README.md).
+// Each scene runs in its own process (this program re-executed) so its peak memory is its own.
+#include "commands.hpp"
+
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
+#include <soak/step.hpp>
+
+#include "core/parallel.hpp"
+#include "io/file.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace soak::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+constexpr int kDefaultSteps = 20;
+constexpr int kDefaultWarmup = 5;
+
+// one scene to time
+struct BenchJob {
+  std::string name;
+  std::string scene;                 // path of the scene file
+  std::vector<std::string> overrides;
+  int warmup = kDefaultWarmup;
+  int steps = kDefaultSteps;
+  bool fromManifest = false;
+  json targets = json::object();     // targetMsPerStep, targetBytesPerParticle
+};
+
+std::string defaultManifest() {
+  const fs::path inSource = fs::path(SOAK_SOURCE_DIR) / "bench" / "benchmarks.json";
+  if (fs::exists(inSource)) return inSource.string();
+  return "bench/benchmarks.json";
+}
+
+std::vector<BenchJob> readManifest(const std::string& path) {
+  const json doc = json::parse(readTextFile(path), nullptr, false, true);
+  if (doc.is_discarded()) throw Error(path + ": invalid JSON");
+  if (!doc.contains("benchmarks") || !doc["benchmarks"].is_array())
+    throw Error(path + ": at benchmarks: expected an array of {name, scene, warmup, steps}");
+  const fs::path base = fs::path(path).parent_path();
+  std::vector<BenchJob> jobs;
+  for (size_t k = 0; k < doc["benchmarks"].size(); ++k) {
+    const json& e = doc["benchmarks"][k];
+    const std::string where = fmt::format("benchmarks.{}", k);
+    if (!e.is_object() || !e.contains("name") || !e["name"].is_string() || !e.contains("scene") ||
+        !e["scene"].is_string())
+      throw Error(path + ": at " + where + ": expected an object with string \"name\" and \"scene\"");
+    BenchJob j;
+    j.name = e["name"];
+    j.scene = (base / e["scene"].get<std::string>()).lexically_normal().string();
+    j.fromManifest = true;
+    for (const char* key : {"warmup", "steps"}) {
+      if (!e.contains(key)) continue;
+      if (!e[key].is_number_integer() || e[key].get<int>() < (key[0] == 's' ? 1 : 0))
+        throw Error(path + ": at " + where + "." + key + ": expected a non-negative integer (steps >= 1)");
+      (key[0] == 's' ? j.steps : j.warmup) = e[key].get<int>();
+    }
+    if (e.contains("set")) {
+      if (!e["set"].is_array()) throw Error(path + ": at " + where + ".set: expected an array of \"key=value\"");
+      for (const json& s : e["set"]) j.overrides.push_back(s.get<std::string>());
+    }
+    for (const char* key : {"targetMsPerStep", "targetBytesPerParticle"})
+      if (e.contains(key)) j.targets[key] = e[key];
+    jobs.push_back(std::move(j));
+  }
+  return jobs;
+}
+
+std::vector<BenchJob> selectJobs(const BenchOptions& o) {
+  const std::string manifestPath = o.manifest.empty() ? defaultManifest() : o.manifest;
+  const bool needManifest = o.scenes.empty() || !o.manifest.empty() ||
+                            std::any_of(o.scenes.begin(), o.scenes.end(), [](const std::string& s) {
+                              return !fs::is_regular_file(s);
+                            });
+  const std::vector<BenchJob> manifest = needManifest ? readManifest(manifestPath) : std::vector<BenchJob>{};
+  std::vector<BenchJob> jobs;
+  if (o.scenes.empty()) jobs = manifest;
+  for (const std::string& s : o.scenes) {
+    const auto it = std::find_if(manifest.begin(), manifest.end(), [&](const BenchJob& j) { return j.name == s; });
+    if (it != manifest.end() && !fs::is_regular_file(s)) {
+      jobs.push_back(*it);
+    } else if (fs::is_regular_file(s)) {
+      BenchJob j;
+      j.name = fs::path(s).stem().string();
+      j.scene = s;
+      jobs.push_back(j);
+    } else {
+      std::string names;
+      for (const BenchJob& j : manifest) names += (names.empty() ? "" : ", ") + j.name;
+      throw Error(s + ": not a scene file nor a benchmark of " + manifestPath + " (" + names + ")");
+    }
+  }
+  for (BenchJob& j : jobs) {
+    if (o.steps > 0) j.steps = o.steps;
+    if (o.warmup >= 0) j.warmup = o.warmup;
+    j.overrides.insert(j.overrides.end(), o.overrides.begin(), o.overrides.end());
+  }
+  return jobs;
+}
+
+// a float as the shortest decimal that reads back to it (0.015, not 0.014999999664723873)
+double decimal(float f) { return std::stod(fmt::format("{}", f)); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// peak resident memory of this process, bytes (Linux reports ru_maxrss in KiB)
+uint64_t peakRssBytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<uint64_t>(u.ru_maxrss) * 1024u;
+}
+
+json runOne(const BenchJob& job, int threads, bool quiet) {
+  Scene scene = loadScene(job.scene, job.overrides);
+  if (threads > 0) setThreadCount(threads);
+  const Model& model = scene.model;
+  State& state = scene.state;
+  const float dt = model.solver.dt;
+  WorkspacePtr ws = makeWorkspace();
+  if (!quiet) std::fprintf(stderr, "soak bench: %s: %d warm-up steps, %d timed steps\n", job.name.c_str(), job.warmup, job.steps);
+  for (int s = 0; s < job.warmup; ++s) {
+    StepStats st;
+    step(model, state, *ws, dt, st);
+  }
+  std::string bad = checkState(model, state);
+  if (!bad.empty()) throw Error(job.scene + ": diverged during warm-up: " + bad);
+  std::vector<StepStats> timed(static_cast<size_t>(job.steps));
+  for (StepStats& st : timed) step(model, state, *ws, dt, st);
+  bad = checkState(model, state);
+  if (!bad.empty()) throw Error(job.scene + ": diverged while timed: " + bad);
+
+  size_t water = 0;
+  for (int32_t ph : state.particles.phase) water += isWater(ph) ? 1 : 0;
+  const size_t particles = state.particles.size();
+  json ms = json::object();
+  const auto stage = [&](const char* name, double StageTimes::*field) {
+    std::vector<double> v;
+    for (const StepStats& st : timed) v.push_back(st.ms.*field);
+    ms[name] = median(v);
+  };
+  stage("emit", &StageTimes::emit);
+  stage("predict", &StageTimes::predict);
+  stage("neighbors", &StageTimes::neighbors);
+  stage("water", &StageTimes::water);
+  stage("cloth", &StageTimes::cloth);
+  stage("coupling", &StageTimes::coupling);
+  stage("colliders", &StageTimes::colliders);
+  stage("velocities", &StageTimes::velocities);
+  stage("total", &StageTimes::total);
+  double meanTotal = 0.0;
+  uint64_t contacts = 0;
+  for (const StepStats& st : timed) {
+    meanTotal += st.ms.total / static_cast<double>(timed.size());
+    contacts += st.couplingContacts;
+  }
+  const uint64_t peak = peakRssBytes();
+  const double medianTotal = ms["total"].get<double>();
+  json r = {{"name", job.name},
+            {"scene", job.scene},
+            {"overrides", job.overrides},
+            {"threads", threadCount()},
+            {"warmup", job.warmup},
+            {"steps", job.steps},
+            {"dt", decimal(dt)},
+            {"particles", {{"water", water}, {"cloth", model.numCloth}, {"total", particles}}},
+            {"iterations",
+             {{"fluid", model.solver.fluidIterations},
+              {"cloth", model.solver.clothIterations},
+              {"coupling", model.solver.couplingIterations},
+              {"substeps", model.solver.substeps}}},
+            {"msPerStepMedian", ms},
+            {"msPerStepMean", meanTotal},
+            {"nsPerParticleStep", particles > 0 ? medianTotal * 1e6 / static_cast<double>(particles) : 0.0},
+            {"couplingContactsPerStep", timed.empty() ? 0.0 : static_cast<double>(contacts) / timed.size()},
+            {"peakRssBytes", peak},
+            {"bytesPerParticle", particles > 0 ? static_cast<double>(peak) / static_cast<double>(particles) : 0.0},
+            {"simulatedSeconds", state.time},
+            {"stateHash", fmt::format("{:016x}", stateHash(state))},
+            {"targets", job.targets}};
+  if (job.targets.contains("targetMsPerStep"))
+    r["targets"]["msPerStepMet"] = medianTotal <= job.targets["targetMsPerStep"].get<double>();
+  if (job.targets.contains("targetBytesPerParticle"))
+    r["targets"]["bytesPerParticleMet"] = r["bytesPerParticle"].get<double>() <= job.targets["targetBytesPerParticle"].get<double>();
+  return r;
+}
+
+// runs `soak bench --scene X` for one job in a fresh process and reads back its JSON
+json runInChild(const BenchJob& job, const BenchOptions& o, int index) {
+  const fs::path out = fs::temp_directory_path() / fmt::format("soak_bench_{}_{}.json", ::getpid(), index);
+  std::vector<std::string> args = {"soak", "bench", "--quiet", "--in-process", "--json", out.string(),
+                                   "--steps", std::to_string(job.steps), "--warmup", std::to_string(job.warmup)};
+  if (job.fromManifest) {
+    args.insert(args.end(), {"--manifest", o.manifest.empty() ? defaultManifest() : o.manifest, "--scene", job.name});
+  } else {
+    args.insert(args.end(), {"--scene", job.scene});
+  }
+  if (o.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.threads)});
+  for (const std::string& s : o.overrides) args.insert(args.end(), {"--set", s});
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, argv.data(), environ) != 0)
+    throw Error("soak bench: cannot start /proc/self/exe for " + job.name);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  // a child that ran but failed still wrote its error into the JSON
+  std::error_code ec;
+  if (fs::exists(out, ec)) {
+    const json doc = json::parse(readTextFile(out.string()), nullptr, false);
+    fs::remove(out, ec);
+    if (!doc.is_discarded() && doc.contains("results") && doc["results"].size() == 1) return doc["results"][0];
+  }
+  const std::string why = WIFEXITED(status) ? fmt::format("exit code {}", WEXITSTATUS(status))
+                                            : fmt::format("signal {}", WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  return {{"name", job.name}, {"scene", job.scene}, {"error", "the benchmark process failed (" + why + ")"}};
+}
+
+std::string mib(double bytes) { return fmt::format("{:.1f}", bytes / (1024.0 * 1024.0)); }
+
+void printTable(const std::vector<json>& results) {
+  std::printf("%-18s %9s %7s %11s %9s %8s %8s %8s %9s %8s %8s %9s %9s %6s  %s\n", "scene", "water", "cloth",
+              "it f/c/cp/s", "neighbors", "water", "cloth", "coupling", "colliders", "total", "mean", "ns/p/step",
+              "peak MiB", "B/p", "target");
+  for (const json& r : results) {
+    if (r.contains("error")) {
+      std::printf("%-18s %s\n", r["name"].get<std::string>().c_str(), r["error"].get<std::string>().c_str());
+      continue;
+    }
+    const json& ms = r["msPerStepMedian"];
+    const json& it = r["iterations"];
+    std::string target;
+    if (r["targets"].contains("msPerStepMet"))
+      target += fmt::format("{} {} ms/step ", r["targets"]["msPerStepMet"].get<bool>() ? "met" : "MISSED",
+                            r["targets"]["targetMsPerStep"].get<double>());
+    if (r["targets"].contains("bytesPerParticleMet"))
+      target += fmt::format("{} {} B/p", r["targets"]["bytesPerParticleMet"].get<bool>() ? "met" : "MISSED",
+                            r["targets"]["targetBytesPerParticle"].get<double>());
+    std::printf("%-18s %9llu %7llu %11s %9.2f %8.2f %8.2f %8.2f %9.2f %8.2f %8.2f %9.1f %9s %6.0f  %s\n",
+                r["name"].get<std::string>().c_str(), r["particles"]["water"].get<unsigned long long>(),
+                r["particles"]["cloth"].get<unsigned long long>(),
+                fmt::format("{}/{}/{}/{}", it["fluid"].get<int>(), it["cloth"].get<int>(), it["coupling"].get<int>(),
+                            it["substeps"].get<int>())
+                    .c_str(),
+                ms["neighbors"].get<double>(), ms["water"].get<double>(), ms["cloth"].get<double>(),
+                ms["coupling"].get<double>(), ms["colliders"].get<double>(), ms["total"].get<double>(),
+                r["msPerStepMean"].get<double>(), r["nsPerParticleStep"].get<double>(),
+                mib(r["peakRssBytes"].get<double>()).c_str(), r["bytesPerParticle"].get<double>(), target.c_str());
+  }
+  std::printf("(ms per step: median over the timed steps; total includes emit, predict and velocities; peak: "
+              "ru_maxrss of the process that ran the scene)\n");
+}
+
+}  // namespace
+
+int benchCommand(const BenchOptions& o) {
+  const std::vector<BenchJob> jobs = selectJobs(o);
+  if (jobs.empty()) throw Error("soak bench: no scenes to run");
+  const bool separate = !o.inProcess && jobs.size() > 1;
+  std::vector<json> results;
+  bool failed = false;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    json r;
+    if (separate) {
+      if (!o.quiet) std::fprintf(stderr, "soak bench: [%zu/%zu] %s\n", k + 1, jobs.size(), jobs[k].name.c_str());
+      r = runInChild(jobs[k], o, static_cast<int>(k));
+    } else {
+      try {
+        r = runOne(jobs[k], o.threads, o.quiet);
+      } catch (const Error& e) {
+        std::fprintf(stderr, "soak: error: %s\n", e.what());
+        r = {{"name", jobs[k].name}, {"scene", jobs[k].scene}, {"error", e.what()}};
+      }
+    }
+    failed |= r.contains("error");
+    results.push_back(std::move(r));
+  }
+  if (!o.quiet) printTable(results);
+  if (!o.json.empty()) {
+    const json doc = {{"soak", kVersion}, {"results", results}};
+    writeTextFile(o.json, doc.dump(2) + "\n");
+  }
+  return failed ? kExitError : kExitOk;
+}
+
+}  // namespace soak::cli

@@ -1,0 +1,51 @@
+// the subcommands of the soak program; each returns the process exit code
+#pragma once
+#include <string>
+#include <vector>
+
+namespace soak::cli {
+
+inline constexpr const char* kVersion = "0.1.0";
+
+// exit codes: 0 success, 1 bad input or I/O error (nothing or little was done), 2 the simulation
+// diverged (checkState failed; the bad frame was written)
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitError = 1;
+inline constexpr int kExitDiverged = 2;
+
+struct RunOptions {
+  std::string scene;
+  std::string outDir;
+  int frames = -1;                     // -1: the scene's output.frames
+  int threads = 0;                     // 0: OpenMP default
+  std::vector<std::string> overrides;  // --set key=value
+  bool overwrite = false;
+  bool quiet = false;
+  std::vector<std::string> commandLine;
+};
+
+struct ValidateOptions {
+  std::string scene;
+  std::vector<std::string> overrides;
+};
+
+struct BenchOptions {
+  std::vector<std::string> scenes;     // files or manifest names; empty: every manifest entry
+  int steps = -1;                      // -1: the manifest's, else 20
+  int warmup = -1;                     // -1: the manifest's, else 5
+  int threads = 0;
+  std::string json;                    // write results here as JSON
+  std::string manifest;                // empty: bench/benchmarks.json of the source tree
+  std::vector<std::string> overrides;  // --set, applied to every scene
+  bool inProcess = false;              // run the scenes in this process (no re-exec per scene)
+  bool quiet = false;
+};
+
+int runCommand(const RunOptions& o);
+int validateCommand(const ValidateOptions& o);
+int benchCommand(const BenchOptions& o);
+
+// "a b 'c d'": argv joined with shell quoting where needed
+std::string joinCommandLine(const std::vector<std::string>& args);
+
+}  // namespace soak::cli

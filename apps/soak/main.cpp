@@ -1,0 +1,96 @@
+// soak command-line program: run, validate and bench scenes (docs/cli.md)
+#include "commands.hpp"
+
+#include <soak/error.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+namespace {
+
+using namespace soak::cli;
+
+// "key=value" for --set: the key must be non-empty
+std::string checkOverride(const std::string& s) {
+  const size_t eq = s.find('=');
+  if (eq == std::string::npos || eq == 0) return "expected key=value (e.g. solver.substeps=3), got '" + s + "'";
+  return {};
+}
+
+int realMain(int argc, char** argv) {
+  CLI::App app{"soak: cloth getting wet (position-based water and porous cloth)", "soak"};
+  app.set_version_flag("--version", std::string("soak ") + kVersion);
+  app.require_subcommand(1);
+  app.failure_message(CLI::FailureMessage::help);
+
+  RunOptions run;
+  for (int i = 0; i < argc; ++i) run.commandLine.emplace_back(argv[i]);
+  CLI::App* runCmd = app.add_subcommand("run", "simulate a scene and write its frames");
+  runCmd->add_option("scene", run.scene, "scene file (JSON)")->required();
+  runCmd->add_option("-o,--out", run.outDir, "output directory (created; must be empty unless --overwrite)")
+      ->required();
+  runCmd->add_option("--frames", run.frames, "frames to write after frame 0 (default: the scene's output.frames)")
+      ->check(CLI::NonNegativeNumber);
+  runCmd->add_option("--threads", run.threads, "worker threads (default: all cores)")->check(CLI::PositiveNumber);
+  runCmd->add_option("--set", run.overrides, "override a scene value, key=value (repeatable)")
+      ->check(checkOverride)
+      ->allow_extra_args(false)
+      ->take_all();
+  runCmd->add_flag("--overwrite", run.overwrite, "write into a non-empty output directory, replacing soak's files");
+  runCmd->add_flag("-q,--quiet", run.quiet, "no progress and no summary");
+
+  ValidateOptions val;
+  CLI::App* valCmd = app.add_subcommand("validate", "load and check a scene, print a summary");
+  valCmd->add_option("scene", val.scene, "scene file (JSON)")->required();
+  valCmd->add_option("--set", val.overrides, "override a scene value, key=value (repeatable)")
+      ->check(checkOverride)
+      ->allow_extra_args(false)
+      ->take_all();
+
+  BenchOptions bench;
+  CLI::App* benchCmd = app.add_subcommand("bench", "time the solver stages on benchmark scenes");
+  benchCmd->add_option("--scene", bench.scenes, "scene file or bench/benchmarks.json entry name (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
+  benchCmd->add_option("--steps", bench.steps, "timed steps per scene (default 20 or the manifest's)")
+      ->check(CLI::PositiveNumber);
+  benchCmd->add_option("--warmup", bench.warmup, "untimed steps first (default 5 or the manifest's)")
+      ->check(CLI::NonNegativeNumber);
+  benchCmd->add_option("--threads", bench.threads, "worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  benchCmd->add_option("--json", bench.json, "also write the results to this JSON file");
+  benchCmd->add_option("--manifest", bench.manifest, "benchmark list (default: bench/benchmarks.json)");
+  benchCmd->add_option("--set", bench.overrides, "override a value in every scene, key=value (repeatable)")
+      ->check(checkOverride)
+      ->allow_extra_args(false)
+      ->take_all();
+  benchCmd->add_flag("--in-process", bench.inProcess,
+                     "run every scene in this process (peak memory is then shared between scenes)");
+  benchCmd->add_flag("-q,--quiet", bench.quiet, "print no table (with --json)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitError;
+  }
+  if (*runCmd) return runCommand(run);
+  if (*valCmd) return validateCommand(val);
+  return benchCommand(bench);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return realMain(argc, argv);
+  } catch (const soak::Error& e) {
+    std::fprintf(stderr, "soak: error: %s\n", e.what());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "soak: error: %s\n", e.what());
+  }
+  return kExitError;
+}

@@ -1,0 +1,51 @@
+#include "progress.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include <unistd.h>
+
+namespace soak::cli {
+
+Progress::Progress(int frames, bool enabled)
+    : frames_(frames), enabled_(enabled), tty_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+
+std::string Progress::formatDuration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  if (s < 60) return fmt::format("{:.1f} s", s);
+  const long total = std::lround(s);
+  if (total < 3600) return fmt::format("{}:{:02d}", total / 60, total % 60);
+  return fmt::format("{}:{:02d}:{:02d}", total / 3600, (total / 60) % 60, total % 60);
+}
+
+void Progress::update(int frame, double simTime, double msPerStep) {
+  if (!enabled_ || frames_ <= 0) return;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double eta = elapsed / frame * (frames_ - frame);
+  const std::string info = fmt::format("frame {}/{}  t = {:.3f} s  {:.1f} ms/step  ETA {}", frame, frames_, simTime,
+                                       msPerStep, formatDuration(eta));
+  if (tty_) {
+    constexpr int kWidth = 30;
+    const int filled = frame * kWidth / frames_;
+    std::fprintf(stderr, "\r[%s%s] %s\033[K", std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, '.').c_str(), info.c_str());
+    std::fflush(stderr);
+    drawn_ = true;
+    return;
+  }
+  // a log file gets a line at each new tenth (and the last frame)
+  const int decile = frame * 10 / frames_;
+  if (decile > lastDecile_ || frame == frames_) {
+    lastDecile_ = decile;
+    std::fprintf(stderr, "soak: %s\n", info.c_str());
+  }
+}
+
+void Progress::finish() {
+  if (drawn_) std::fputc('\n', stderr);
+  drawn_ = false;
+}
+
+}  // namespace soak::cli

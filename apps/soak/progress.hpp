@@ -1,0 +1,26 @@
+// progress of a run on stderr: a redrawn bar on a terminal, a plain line every ~10% otherwise
+#pragma once
+#include <chrono>
+#include <string>
+
+namespace soak::cli {
+
+class Progress {
+ public:
+  Progress(int frames, bool enabled);
+  // after frame `frame` (1..frames) at simulated time t (s) with the frame's mean ms per step
+  void update(int frame, double simTime, double msPerStep);
+  // ends the bar's line (a terminal needs the newline)
+  void finish();
+  // "1:02:03", "4:05" or "6.7 s"
+  static std::string formatDuration(double seconds);
+
+ private:
+  int frames_;
+  bool enabled_, tty_;
+  int lastDecile_ = 0;
+  bool drawn_ = false;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace soak::cli

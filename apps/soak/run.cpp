@@ -1,0 +1,275 @@
+// `soak run` and `soak validate`: load a scene, simulate it frame by frame and write the frames
+#include "commands.hpp"
+
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
+#include <soak/step.hpp>
+
+#include "core/parallel.hpp"
+#include "io/file.hpp"
+#include "io/output.hpp"
+#include "io/stats.hpp"
+#include "progress.hpp"
+#include "scene/overrides.hpp"
+#include "world/emitters.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <regex>
+
+namespace soak::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::string isoTimeNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return buf;
+}
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// the files a run writes; --overwrite removes only these, never anything else in the directory
+bool isSoakOutput(const std::string& name) {
+  static const std::regex frameFile(R"((cloth|water)_\d{4,}\.(obj|ply))");
+  return name == "stats.jsonl" || name == "scene.json" || name == "run.json" || std::regex_match(name, frameFile);
+}
+
+void prepareOutputDir(const std::string& dir, bool overwrite) {
+  std::error_code ec;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec)) throw Error(dir + ": output path exists and is not a directory");
+    if (!fs::is_empty(dir, ec)) {
+      if (!overwrite)
+        throw Error(dir + ": output directory is not empty; pass --overwrite to replace soak's files in it, or "
+                          "choose another directory");
+      for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.is_regular_file() && isSoakOutput(entry.path().filename().string())) fs::remove(entry.path());
+    }
+    return;
+  }
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(dir + ": cannot create the output directory: " + ec.message());
+}
+
+// relative file paths in the scene ("mesh": {"path": ...}) made absolute against the scene's folder,
+// so dir/scene.json runs from anywhere
+void resolvePaths(nlohmann::json& v, const fs::path& baseDir) {
+  if (v.is_object()) {
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      if (it.key() == "path" && it->is_string()) {
+        const fs::path p = it->get<std::string>();
+        if (p.is_relative() && fs::exists(baseDir / p)) *it = fs::absolute(baseDir / p).lexically_normal().string();
+      } else {
+        resolvePaths(*it, baseDir);
+      }
+    }
+  } else if (v.is_array()) {
+    for (auto& e : v) resolvePaths(e, baseDir);
+  }
+}
+
+// the scene file as run: its JSON with the --set overrides applied and paths resolved
+void writeResolvedScene(const RunOptions& o, const std::string& path) {
+  nlohmann::json doc = parseSceneJson(readTextFile(o.scene), o.scene);
+  applyOverrides(doc, o.overrides, o.scene);
+  resolvePaths(doc, fs::absolute(o.scene).parent_path());
+  writeTextFile(path, doc.dump(2) + "\n");
+}
+
+nlohmann::ordered_json waterJson(const WaterMass& w, const State& s) {
+  return {{"freeKg", w.free},
+          {"emittedKg", w.emitted},
+          {"removedAtBoundsKg", w.removedAtBounds},
+          {"particlesRemovedAtBounds", s.ledger.particlesRemovedAtBounds},
+          {"unaccountedKg", w.emitted - w.total}};
+}
+
+std::string outputList(const Model& model, const OutputSettings& out) {
+  std::string s;
+  if (model.numCloth > 0 && out.clothObj) s += "cloth_NNNN.obj, ";
+  if (model.numCloth > 0 && out.clothPly) s += "cloth_NNNN.ply, ";
+  if (out.water) s += "water_NNNN.ply, ";
+  return s + "stats.jsonl";
+}
+
+// water particles the block emitters will create (emitted on a copy, so the counts are the emitter's own)
+size_t blockParticles(const Model& m) {
+  Model blocks = m;
+  blocks.emitters.clear();
+  double first = 0.0, last = 0.0;
+  for (const Emitter& e : m.emitters) {
+    if (e.kind != EmitterKind::Block) continue;
+    first = blocks.emitters.empty() ? e.start : std::min(first, static_cast<double>(e.start));
+    last = blocks.emitters.empty() ? e.start : std::max(last, static_cast<double>(e.start));
+    blocks.emitters.push_back(e);
+  }
+  if (blocks.emitters.empty()) return 0;
+  State s;
+  s.emitters.resize(blocks.emitters.size());
+  return emitWater(blocks, s, first - 1.0, static_cast<float>(last - first + 2.0));
+}
+
+}  // namespace
+
+std::string joinCommandLine(const std::vector<std::string>& args) {
+  std::string s;
+  for (const std::string& a : args) {
+    if (!s.empty()) s += ' ';
+    const bool plain = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                         "0123456789-_./=:,+@%") == std::string::npos;
+    if (plain) {
+      s += a;
+      continue;
+    }
+    s += '\'';
+    for (char c : a) s += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    s += '\'';
+  }
+  return s;
+}
+
+int runCommand(const RunOptions& o) {
+  const Clock::time_point wallStart = Clock::now();
+  const std::string startTime = isoTimeNow();
+  // everything that can be wrong with the input fails here, before any output exists
+  Scene scene = loadScene(o.scene, o.overrides);
+  if (o.threads > 0) setThreadCount(o.threads);
+  const Model& model = scene.model;
+  State& state = scene.state;
+  const OutputSettings& out = scene.output;
+  const int frames = o.frames >= 0 ? o.frames : out.frames;
+  const int stepsPerFrame = std::max(1, out.stepsPerFrame);
+  const float dt = model.solver.dt;
+
+  prepareOutputDir(o.outDir, o.overwrite);
+  const fs::path dir(o.outDir);
+  writeResolvedScene(o, (dir / "scene.json").string());
+  nlohmann::ordered_json run = {{"soak", kVersion},
+                        {"threads", threadCount()},
+                        {"commandLine", joinCommandLine(o.commandLine)},
+                        {"scene", fs::absolute(o.scene).lexically_normal().string()},
+                        {"overrides", o.overrides},
+                        {"frames", frames},
+                        {"stepsPerFrame", stepsPerFrame},
+                        {"dt", std::stod(fmt::format("{}", dt))},
+                        {"startTime", startTime},
+                        {"status", "running"}};
+  const std::string runPath = (dir / "run.json").string();
+  const auto writeRun = [&](const std::string& status, int framesWritten) {
+    run["status"] = status;
+    run["framesWritten"] = framesWritten;
+    run["wallSeconds"] = secondsSince(wallStart);
+    run["steps"] = state.stepCount;
+    run["simulatedSeconds"] = state.time;
+    run["stateHash"] = fmt::format("{:016x}", stateHash(state));
+    run["water"] = waterJson(waterMass(state), state);
+    writeTextFile(runPath, run.dump(2) + "\n");
+  };
+  writeRun("running", 0);
+
+  JsonLinesWriter stats((dir / "stats.jsonl").string());
+  WorkspacePtr ws = makeWorkspace();
+  Progress progress(frames, !o.quiet);
+  const Clock::time_point simStart = Clock::now();
+  int written = 0;
+  try {
+    for (int frame = 0; frame <= frames; ++frame) {
+      FrameStats fs;
+      for (int s = 0; frame > 0 && s < stepsPerFrame; ++s) {
+        StepStats st;
+        step(model, state, *ws, dt, st);
+        fs.add(st);
+      }
+      const std::string bad = checkState(model, state);
+      // a diverged frame is written too: it shows where the blow-up started
+      writeFrameFiles(dir.string(), model, state, out, frame);
+      nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
+      if (!bad.empty()) line["error"] = bad;
+      stats.write(line);
+      ++written;
+      if (!bad.empty()) {
+        progress.finish();
+        writeRun("diverged", written);
+        std::fprintf(stderr,
+                     "soak: simulation diverged at frame %d (t = %.4f s, step %llu): %s\n"
+                     "soak: frame %d was written to %s and marked \"error\" in stats.jsonl; the last good frame is "
+                     "%d\n",
+                     frame, state.time, static_cast<unsigned long long>(state.stepCount), bad.c_str(), frame,
+                     o.outDir.c_str(), frame - 1);
+        return kExitDiverged;
+      }
+      if (frame > 0) progress.update(frame, state.time, fs.ms.total / std::max(1, fs.steps));
+    }
+  } catch (const Error&) {
+    progress.finish();
+    writeRun("error", written);
+    throw;
+  }
+  progress.finish();
+  writeRun("ok", written);
+
+  if (!o.quiet) {
+    const double simSeconds = secondsSince(simStart);
+    const WaterMass w = waterMass(state);
+    std::printf("soak: wrote frames 0..%d of %s to %s (%s, scene.json, run.json)\n", frames, scene.name.c_str(),
+                o.outDir.c_str(), outputList(model, out).c_str());
+    std::printf("soak: %llu steps of %g s in %s (%.2f ms/step) on %d threads\n",
+                static_cast<unsigned long long>(state.stepCount), static_cast<double>(dt),
+                Progress::formatDuration(simSeconds).c_str(),
+                state.stepCount > 0 ? 1e3 * simSeconds / static_cast<double>(state.stepCount) : 0.0, threadCount());
+    std::printf("soak: water: emitted %.6g kg = free %.6g kg + removed at bounds %.6g kg (%llu particles); "
+                "unaccounted %.3g kg\n",
+                w.emitted, w.free, w.removedAtBounds,
+                static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.emitted - w.total);
+  }
+  return kExitOk;
+}
+
+int validateCommand(const ValidateOptions& o) {
+  const Scene scene = loadScene(o.scene, o.overrides);
+  const Model& m = scene.model;
+  const SolverParams& s = m.solver;
+  size_t water = 0;
+  for (int32_t ph : scene.state.particles.phase) water += isWater(ph) ? 1 : 0;
+  size_t pinned = 0;
+  for (uint8_t p : m.clothPinned) pinned += p;
+  std::printf("%s: valid\n", o.scene.c_str());
+  std::printf("  name:        %s\n", scene.name.c_str());
+  std::printf("  particles:   %d cloth, %zu water at start, %zu water from blocks\n", m.numCloth, water,
+              blockParticles(m));
+  std::printf("  cloth:       %zu pieces, %zu triangles, %zu pinned particles\n", m.pieces.size(), m.triangles.size(),
+              pinned);
+  for (const ClothPiece& p : m.pieces)
+    std::printf("    %-12s %d particles, %d triangles\n", p.name.c_str(), p.particleCount, p.triangleCount);
+  std::printf("  colliders:   %zu\n", m.colliders.size());
+  for (const Collider& c : m.colliders) std::printf("    %s\n", c.name.c_str());
+  std::printf("  emitters:    %zu\n", m.emitters.size());
+  for (const Emitter& e : m.emitters) {
+    if (e.kind == EmitterKind::Block)
+      std::printf("    %-12s block at t = %g s\n", e.name.c_str(), static_cast<double>(e.start));
+    else
+      std::printf("    %-12s jet of radius %g m at %g m/s, t = %g..%g s\n", e.name.c_str(),
+                  static_cast<double>(e.radius), static_cast<double>(e.speed), static_cast<double>(e.start),
+                  static_cast<double>(e.end));
+  }
+  std::printf("  dt:          %g s, %d substeps\n", static_cast<double>(s.dt), s.substeps);
+  std::printf("  iterations:  fluid %d, cloth %d, coupling %d\n", s.fluidIterations, s.clothIterations,
+              s.couplingIterations);
+  std::printf("  output:      %d frames of %d steps (%g s simulated)\n", scene.output.frames,
+              scene.output.stepsPerFrame,
+              static_cast<double>(s.dt) * scene.output.stepsPerFrame * scene.output.frames);
+  return kExitOk;
+}
+
+}  // namespace soak::cli

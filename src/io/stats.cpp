@@ -1,0 +1,79 @@
+#include "io/stats.hpp"
+
+#include "io/file.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+void FrameStats::add(const StepStats& s) {
+  ++steps;
+  substeps += s.substeps;
+  ms += s.ms;
+  couplingContacts += s.couplingContacts;
+  emittedParticles += s.emittedParticles;
+  removedParticles += s.removedParticles;
+  densityRatioSum += s.meanDensityRatio;
+  maxSpeed = std::max(maxSpeed, s.maxSpeed);
+}
+
+WaterMass waterMass(const State& state) {
+  WaterMass w;
+  const Particles& p = state.particles;
+  for (size_t i = 0; i < p.size(); ++i)
+    if (isWater(p.phase[i])) w.free += p.mass[i];
+  w.emitted = state.ledger.emitted;
+  w.removedAtBounds = state.ledger.removedAtBounds;
+  w.total = w.free + w.removedAtBounds;
+  return w;
+}
+
+float stateMaxSpeed(const State& state) {
+  float m2 = 0.0f;
+  for (const Vec3& v : state.particles.v) m2 = std::max(m2, v.squaredNorm());
+  return std::sqrt(m2);
+}
+
+static nlohmann::ordered_json stageJson(const StageTimes& t) {
+  return {{"emit", t.emit},         {"predict", t.predict},     {"neighbors", t.neighbors},
+          {"water", t.water},       {"cloth", t.cloth},         {"coupling", t.coupling},
+          {"colliders", t.colliders}, {"velocities", t.velocities}, {"total", t.total}};
+}
+
+nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, int frame, const FrameStats& fs) {
+  const Particles& p = state.particles;
+  uint64_t water = 0;
+  for (size_t i = 0; i < p.size(); ++i) water += isWater(p.phase[i]) ? 1 : 0;
+  const WaterMass w = waterMass(state);
+  nlohmann::ordered_json j;
+  j["frame"] = frame;
+  j["time"] = state.time;
+  j["step"] = state.stepCount;
+  j["steps"] = fs.steps;
+  j["substeps"] = fs.substeps;
+  j["counts"] = {{"water", water}, {"cloth", model.numCloth}};
+  j["waterMass"] = {{"free", w.free}, {"emitted", w.emitted}, {"removedAtBounds", w.removedAtBounds},
+                    {"total", w.total}};
+  j["removedAtBounds"] = {{"frame", fs.removedParticles}, {"total", state.ledger.particlesRemovedAtBounds}};
+  j["emittedParticles"] = fs.emittedParticles;
+  j["couplingContacts"] = fs.couplingContacts;
+  if (fs.steps > 0)
+    j["meanDensityRatio"] = fs.densityRatioSum / fs.steps;
+  else
+    j["meanDensityRatio"] = nullptr;
+  j["maxSpeed"] = fs.steps > 0 ? fs.maxSpeed : stateMaxSpeed(state);
+  j["ms"] = stageJson(fs.ms);
+  j["msPerStep"] = fs.steps > 0 ? fs.ms.total / fs.steps : 0.0;
+  return j;
+}
+
+JsonLinesWriter::JsonLinesWriter(const std::string& path) : path_(path), out_(openForWrite(path)) {}
+
+void JsonLinesWriter::write(const nlohmann::ordered_json& line) {
+  out_ << line.dump() << '\n';
+  out_.flush();
+  if (!out_) throw Error(path_ + ": write failed");
+}
+
+}  // namespace soak

@@ -1,0 +1,16 @@
+// long range attachments (Kim, Chentanez, Müller 2012) between free cloth particles and the pinned ones
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+namespace soak {
+
+// rebuilds model.tethers from the pins and the stretch edges: each free particle is tied to up to
+// maxAnchors pinned particles of its piece, the nearest by shortest path along mesh edges
+void buildTethers(Model& model, int maxAnchors = 4);
+
+// projects every free cloth particle back inside the spheres |x - x_anchor| <= length (the anchors
+// are pinned, so only the free particle moves; gather style)
+void solveTethers(const Model& model, Particles& p);
+
+}  // namespace soak

@@ -1,0 +1,258 @@
+// the soak program end to end: run, validate, bench and --version on small scenes in a temp dir
+#include <gtest/gtest.h>
+
+#include "io/file.hpp"
+#include "io/ply.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace soak {
+namespace {
+
+namespace fs = std::filesystem;
+
+// a 10 x 10 cloth pinned at its corners under a 4 x 4 x 4 block of water, 3 frames of 2 steps
+constexpr const char* kTinyScene = R"({
+  "name": "tiny",
+  "description": "cli test: a small cloth under a small block",
+  "solver": {"dt": 0.01, "substeps": 1, "domain": {"min": [-1, -1, -1], "max": [1, 2, 1]}},
+  "output": {"frames": 3, "stepsPerFrame": 2},
+  "cloth": [{
+    "name": "sheet",
+    "mesh": {"type": "rectangle", "center": [0, 0.5, 0], "size": [0.2, 0.2], "resolution": [10, 10],
+             "axisU": [1, 0, 0], "axisV": [0, 0, 1]},
+    "pin": {"corners": [0, 1, 2, 3]}
+  }],
+  "emitters": [{"name": "cube", "type": "block", "min": [-0.04, 0.54, -0.04], "max": [0.04, 0.62, 0.04]}]
+})";
+constexpr int kTinyWater = 64;  // 4 x 4 x 4 lattice sites of 0.02 m
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+class Cli {
+ public:
+  explicit Cli(const std::string& name)
+      : dir_(fs::temp_directory_path() / ("soak_cli_test_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  ~Cli() { fs::remove_all(dir_); }
+  fs::path dir() const { return dir_; }
+
+  std::string writeScene(const std::string& name, const std::string& text) const {
+    const std::string path = (dir_ / name).string();
+    writeTextFile(path, text);
+    return path;
+  }
+
+  // runs SOAK_BINARY with `args` (already shell-quoted where needed)
+  Result run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("'") + SOAK_BINARY + "' " + args + " > '" + out.string() + "' 2> '" +
+                            err.string() + "'";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = readTextFile(out.string());
+    r.err = readTextFile(err.string());
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+ private:
+  fs::path dir_;
+};
+
+std::vector<nlohmann::json> readJsonLines(const fs::path& path) {
+  std::vector<nlohmann::json> lines;
+  std::istringstream ss(readTextFile(path.string()));
+  for (std::string l; std::getline(ss, l);) lines.push_back(nlohmann::json::parse(l));
+  return lines;
+}
+
+TEST(CliRun, TinySceneWritesEveryFrameAndAccountsWater) {
+  const Cli cli("tiny");
+  const std::string scene = cli.writeScene("tiny.json", kTinyScene);
+  const fs::path out = cli.dir() / "out";
+  const Result r = cli.run("run '" + scene + "' -o '" + out.string() + "' --threads 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int f = 0; f <= 3; ++f)
+    for (const char* name : {"cloth_%04d.obj", "cloth_%04d.ply", "water_%04d.ply"}) {
+      char file[32];
+      std::snprintf(file, sizeof file, name, f);
+      EXPECT_TRUE(fs::exists(out / file)) << file;
+    }
+  EXPECT_FALSE(fs::exists(out / "water_0004.ply"));
+  EXPECT_TRUE(fs::exists(out / "scene.json"));
+  const nlohmann::json run = nlohmann::json::parse(readTextFile((out / "run.json").string()));
+  EXPECT_EQ(run["status"], "ok");
+  EXPECT_EQ(run["framesWritten"], 4);
+  EXPECT_EQ(run["threads"], 2);
+
+  const auto lines = readJsonLines(out / "stats.jsonl");
+  ASSERT_EQ(lines.size(), 4u);  // frame 0 and 3 frames
+  for (size_t f = 0; f < lines.size(); ++f) {
+    const nlohmann::json& l = lines[f];
+    EXPECT_EQ(l["frame"], f);
+    EXPECT_EQ(l["step"], 2 * f);
+    EXPECT_FALSE(l.contains("error"));
+    EXPECT_EQ(l["counts"]["cloth"], 100);
+    const double emitted = l["waterMass"]["emitted"];
+    const double accounted = l["waterMass"]["free"].get<double>() + l["waterMass"]["removedAtBounds"].get<double>();
+    EXPECT_NEAR(accounted, emitted, 1e-5 * std::max(emitted, 1e-3)) << "frame " << f;
+  }
+  // the block is emitted in the first step and nothing leaves the domain in 0.06 s
+  EXPECT_EQ(lines[3]["counts"]["water"], kTinyWater);
+  EXPECT_NEAR(lines[3]["waterMass"]["emitted"].get<double>(), kTinyWater * 0.0082, 1e-6);
+  EXPECT_GT(lines[3]["ms"]["total"].get<double>(), 0.0);
+
+  // the frame files agree with the stats
+  const PlyData water = readPly((out / "water_0003.ply").string());
+  EXPECT_EQ(water.element("vertex").count, static_cast<size_t>(kTinyWater));
+  const PlyData cloth = readPly((out / "cloth_0003.ply").string());
+  EXPECT_EQ(cloth.element("vertex").count, 100u);
+  EXPECT_EQ(cloth.element("face").count, 2u * 9 * 9);
+  // scene.json is the scene as run: it validates on its own
+  const Result again = cli.run("validate '" + (out / "scene.json").string() + "'");
+  EXPECT_EQ(again.code, 0) << again.err;
+}
+
+TEST(CliRun, RefusesNonEmptyOutputDirWithoutOverwrite) {
+  const Cli cli("nonempty");
+  const std::string scene = cli.writeScene("tiny.json", kTinyScene);
+  const fs::path out = cli.dir() / "out";
+  fs::create_directories(out);
+  writeTextFile((out / "notes.txt").string(), "mine");
+  const Result r = cli.run("run '" + scene + "' -o '" + out.string() + "' --frames 1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("not empty"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--overwrite"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "stats.jsonl"));
+
+  const Result o = cli.run("run '" + scene + "' -o '" + out.string() + "' --frames 1 --overwrite --quiet");
+  EXPECT_EQ(o.code, 0) << o.err;
+  EXPECT_TRUE(fs::exists(out / "water_0001.ply"));
+  EXPECT_EQ(readTextFile((out / "notes.txt").string()), "mine");  // --overwrite leaves other files alone
+  EXPECT_EQ(readJsonLines(out / "stats.jsonl").size(), 2u);
+}
+
+TEST(CliRun, BadSceneFailsBeforeAnyOutputNamingTheFile) {
+  const Cli cli("bad");
+  const std::string broken = cli.writeScene("broken.json", R"({"solver": {"substeps": "many"}})");
+  const fs::path out = cli.dir() / "out";
+  Result r = cli.run("run '" + broken + "' -o '" + out.string() + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(broken), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("solver.substeps"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  const std::string missing = (cli.dir() / "missing.json").string();
+  r = cli.run("run '" + missing + "' -o '" + out.string() + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(missing), std::string::npos) << r.err;
+
+  r = cli.run("validate '" + broken + "'");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(broken), std::string::npos) << r.err;
+
+  const std::string tiny = cli.writeScene("tiny.json", kTinyScene);
+  r = cli.run("run '" + tiny + "' -o '" + out.string() + "' --set solver.dt=-1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("solver.dt"), std::string::npos) << r.err;
+}
+
+TEST(CliRun, DivergenceWritesTheBadFrameAndExitsTwo) {
+  const Cli cli("diverge");
+  const std::string scene = cli.writeScene("tiny.json", kTinyScene);
+  const fs::path out = cli.dir() / "out";
+  // anything falling for 0.02 s moves faster than 0.05 m/s
+  const Result r = cli.run("run '" + scene + "' -o '" + out.string() + "' --set solver.maxSpeed=0.05");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("frame 1"), std::string::npos) << r.err;
+  const auto lines = readJsonLines(out / "stats.jsonl");
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_FALSE(lines[0].contains("error"));
+  ASSERT_TRUE(lines[1].contains("error"));
+  EXPECT_NE(lines[1]["error"].get<std::string>().find("maxSpeed"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out / "cloth_0001.obj"));
+  EXPECT_FALSE(fs::exists(out / "cloth_0002.obj"));
+  EXPECT_EQ(nlohmann::json::parse(readTextFile((out / "run.json").string()))["status"], "diverged");
+}
+
+TEST(CliValidate, EveryShippedSceneIsValid) {
+  const Cli cli("validate");
+  int scenes = 0;
+  for (const char* folder : {"scenes", "bench"}) {
+    const fs::path dir = fs::path(SOAK_SOURCE_DIR) / folder;
+    if (!fs::exists(dir)) continue;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      if (e.path().extension() != ".json" || e.path().filename() == "benchmarks.json") continue;
+      const Result r = cli.run("validate '" + e.path().string() + "'");
+      EXPECT_EQ(r.code, 0) << e.path() << "\n" << r.err;
+      EXPECT_NE(r.out.find("valid"), std::string::npos) << r.out;
+      ++scenes;
+    }
+  }
+  EXPECT_GE(scenes, 4);
+}
+
+TEST(CliValidate, SummaryCountsParticlesAndPieces) {
+  const Cli cli("summary");
+  const std::string scene = cli.writeScene("tiny.json", kTinyScene);
+  const Result r = cli.run("validate '" + scene + "' --set solver.substeps=3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("100 cloth"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("64 water from blocks"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 pieces"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("3 substeps"), std::string::npos) << r.out;
+}
+
+TEST(CliVersion, PrintsTheVersion) {
+  const Cli cli("version");
+  const Result r = cli.run("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("soak 0."), std::string::npos) << r.out;
+  EXPECT_EQ(cli.run("").code, 1);              // no subcommand
+  EXPECT_EQ(cli.run("run --frames 2").code, 1);  // no scene, no -o
+}
+
+TEST(CliBench, TimesEachSceneInItsOwnProcess) {
+  const Cli cli("bench");
+  const std::string a = cli.writeScene("tiny_a.json", kTinyScene);
+  const std::string b = cli.writeScene("tiny_b.json", kTinyScene);
+  const fs::path json = cli.dir() / "bench.json";
+  const Result r = cli.run("bench --scene '" + a + "' --scene '" + b + "' --steps 2 --warmup 1 --threads 1 --json '" +
+                           json.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("tiny_a"), std::string::npos) << r.out;
+  const nlohmann::json doc = nlohmann::json::parse(readTextFile(json.string()));
+  ASSERT_EQ(doc["results"].size(), 2u);
+  for (const nlohmann::json& res : doc["results"]) {
+    EXPECT_FALSE(res.contains("error")) << res.dump();
+    EXPECT_EQ(res["particles"]["cloth"], 100);
+    EXPECT_EQ(res["particles"]["water"], kTinyWater);
+    EXPECT_EQ(res["steps"], 2);
+    EXPECT_EQ(res["threads"], 1);
+    EXPECT_GT(res["msPerStepMedian"]["total"].get<double>(), 0.0);
+    EXPECT_GT(res["peakRssBytes"].get<double>(), 1e6);
+    EXPECT_NEAR(res["bytesPerParticle"].get<double>(), res["peakRssBytes"].get<double>() / 164.0, 1e-6);
+  }
+  // a scene that is neither a file nor a manifest entry is refused
+  const Result bad = cli.run("bench --scene no_such_benchmark --steps 1");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("no_such_benchmark"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace soak
