@@ -22,7 +22,7 @@ struct WaterParams {
   float spacing = 0.02f;          // m, r_0: initial particle spacing (Table 1)
   float supportRadius = 0.04f;    // m, h: SPH support radius (Table 1)
   float particleMass = 0.0082f;   // kg, mass of a full-size water particle (Table 1)
-  float relaxation = 1.0f;        // CFM epsilon of PBF's lambda (Macklin 2013 Eq. 11), in units of w_i / h_i^2
+  float relaxation = 0.1f;        // CFM epsilon of PBF's lambda (Macklin 2013 Eq. 11), in units of w_i / h_i^2
   float viscosity = 0.02f;        // XSPH coefficient c (Macklin 2013 Eq. 17), with volume-weighted W
   float vorticity = 0.0f;         // vorticity confinement epsilon (Macklin 2013 Eq. 16), m/s^2 scale
   float tensileK = 0.1f;          // artificial pressure k (Macklin 2013 Eq. 13)

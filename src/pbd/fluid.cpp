@@ -126,15 +126,20 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
     });
     // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
     parallelFor(nc, [&](int64_t b) {
+      s.delta[b].setZero();
       if (p.invMass[b] == 0.0f) return;
       Vec3 dx = Vec3::Zero();
+      int pushing = 0;
       for (uint32_t k = nb.start[b]; k < nb.start[b + 1]; ++k) {
         const uint32_t i = nb.index[k];
-        if (!isWater(p.phase[i])) continue;
+        if (!isWater(p.phase[i]) || s.lambda[i] == 0.0f) continue;
         const Vec3 r = p.xPred[i] - p.xPred[b];
         dx -= p.mass[i] * s.lambda[i] * spikyGrad(r, pairRadius(p.radius[i], p.radius[b]));
+        ++pushing;
       }
-      s.delta[b] = (p.invMass[b] * s.psi[b] / rho0) * dx;
+      // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
+      // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
+      if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * dx;
     });
     parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
       if (i >= nc || p.invMass[i] != 0.0f) p.xPred[i] += s.delta[i];
