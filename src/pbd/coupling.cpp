@@ -63,9 +63,22 @@ uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb
   const int64_t n = static_cast<int64_t>(p.size());
   if (nc == 0 || n == nc) return 0;
   const int nThreads = omp_get_max_threads();
+  const size_t nTri = model.triangles.size();
   s.perThread.resize(static_cast<size_t>(nThreads));
-  if (s.triangleStiffness.size() != model.triangles.size()) s.triangleStiffness.assign(model.triangles.size(), 1.0f);
+  s.seen.resize(static_cast<size_t>(nThreads));
+  if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
+  // triangle normals once per pass, shared by every water particle that tests the triangle
+  s.startNormal.resize(nTri);
+  s.normal.resize(nTri);
+  parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
+    const auto& f = model.triangles[t];
+    const Vec3 n0 = (p.x[f[1]] - p.x[f[0]]).cross(p.x[f[2]] - p.x[f[0]]);
+    const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
+    const float l0 = n0.norm(), l1 = n1.norm();
+    s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
+    s.normal[t] = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
+  });
 
   // each thread takes one contiguous range of water particles, in order, so concatenating the
   // per-thread lists gives the contacts in ascending water order for any thread count
@@ -73,54 +86,56 @@ uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     std::vector<CouplingContact>& out = s.perThread[static_cast<size_t>(t)];
+    std::vector<uint32_t>& seen = s.seen[static_cast<size_t>(t)];
+    seen.assign(nTri, ~0u);
     out.clear();
     const int64_t nw = n - nc;
     const int64_t begin = nc + nw * t / nt, end = nc + nw * (t + 1) / nt;
-    std::vector<uint32_t> tris;
     for (int64_t q = begin; q < end; ++q) {
+      const float wq = p.invMass[q];
+      const Vec3 xq0 = p.x[q];
+      Vec3 dq = Vec3::Zero();
       // candidate triangles: those around the cloth particles in q's neighbourhood, each once
-      tris.clear();
       for (uint32_t k = nb.start[q]; k < nb.start[q + 1]; ++k) {
         const uint32_t j = nb.index[k];
         if (static_cast<int64_t>(j) >= nc) continue;
-        for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e)
-          tris.push_back(static_cast<uint32_t>(model.vertexTriangles[e]));
-      }
-      if (tris.empty()) continue;
-      std::sort(tris.begin(), tris.end());
-      tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
-      const float wq = p.invMass[q];
-      Vec3 dq = Vec3::Zero();
-      for (uint32_t tri : tris) {
-        const auto& f = model.triangles[tri];
-        const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
-        // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
-        Vec3 n0, b0;
-        const float c0 = couplingConstraint(p.x[q], p.x[f[0]], p.x[f[1]], p.x[f[2]], 1.0f, 0.0f, n0, b0);
-        if (n0.isZero()) continue;
-        const float side = c0 >= 0.0f ? 1.0f : -1.0f;
-        Vec3 nrm, bary;
-        const float C = couplingConstraint(p.xPred[q] + dq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness,
-                                           nrm, bary);
-        if (C >= 0.0f || nrm.isZero()) continue;
-        // only a contact over the triangle's face (or one crossed from it) counts; far below or
-        // beside it is another triangle's business
-        const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
-        const Vec3 off = p.xPred[q] + dq - pt;
-        const float along = std::fabs(off.dot(nrm));
-        if ((off - off.dot(nrm) * nrm).squaredNorm() > 0.25f * thickness * thickness) continue;
-        if (along > p.radius[q] + (p.xPred[q] - p.x[q]).norm()) continue;
-        const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
-                    wc = rigidCloth ? 0.0f : p.invMass[f[2]];
-        const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
-        if (denom <= 0.0f) continue;
-        // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
-        const float k = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
-        const float dl = -C / denom * k;
-        const Vec3 g = side * nrm;
-        dq += wq * dl * g;
-        if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
-        else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+        for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e) {
+          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[e]);
+          if (seen[tri] == static_cast<uint32_t>(q)) continue;
+          seen[tri] = static_cast<uint32_t>(q);
+          const auto& f = model.triangles[tri];
+          const Vec3& n0 = s.startNormal[tri];
+          const Vec3& n1 = s.normal[tri];
+          if (n0.isZero() || n1.isZero()) continue;
+          // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
+          const float side = (xq0 - p.x[f[0]]).dot(n0) >= 0.0f ? 1.0f : -1.0f;
+          const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
+          const Vec3 xq = p.xPred[q] + dq;
+          // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
+          // triangles end here, before the closest point is needed
+          const float C = side * (xq - p.xPred[f[0]]).dot(n1) - thickness;
+          if (C >= 0.0f) continue;
+          Vec3 nrm, bary;
+          couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
+          // only a contact over the triangle's face (or one crossed from it) counts; far below or
+          // beside it is another triangle's business
+          const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
+          const Vec3 off = xq - pt;
+          const float along = std::fabs(off.dot(n1));
+          if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
+          if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
+          const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
+                      wc = rigidCloth ? 0.0f : p.invMass[f[2]];
+          const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
+          if (denom <= 0.0f) continue;
+          // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
+          const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
+          const float dl = -C / denom * kappa;
+          const Vec3 g = side * n1;
+          dq += wq * dl * g;
+          if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
+          else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+        }
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

@@ -18,6 +18,9 @@ struct CouplingContact {
 
 struct CouplingScratch {
   std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
+  std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
+  std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep
+  std::vector<Vec3> normal;                  // unit normal of each triangle at the predicted positions
   std::vector<Vec3> clothDelta;
   std::vector<uint32_t> clothCount;
   std::vector<float> triangleStiffness;   // kappa^couple per triangle (Eq. 22 drives it; 1 when dry)
