@@ -1,0 +1,130 @@
+// modified PCG of Baraff & Witkin 1998 (Fig. "modified-pcg") on 3x3 block matrices
+#include "garment/block_cg.hpp"
+
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+// one CG iteration is a few hundred flops per row: below this many rows its loops run on the calling
+// thread, where three forks per iteration cost more than the work (much more on a busy machine)
+constexpr int64_t kCgParallelRows = 16384;
+
+template <class F>
+void rowsFor(int64_t n, F&& body) {
+  if (n >= kCgParallelRows)
+    parallelFor(n, body);
+  else
+    for (int64_t i = 0; i < n; ++i) body(i);
+}
+
+// sum of per-row terms in row order: the same for any thread count
+double orderedSum(const std::vector<double>& terms) {
+  double s = 0.0;
+  for (double t : terms) s += t;
+  return s;
+}
+
+}  // namespace
+
+void BlockMatrix::multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) const {
+  y.resize(static_cast<size_t>(rows));
+  rowsFor(rows, [&](int64_t i) {
+    Vec3d sum = Vec3d::Zero();
+    for (int k = rowStart[i]; k < rowStart[i + 1]; ++k) sum += block[k] * x[col[k]];
+    y[i] = sum;
+  });
+}
+
+double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::vector<double>& partial) {
+  partial.resize(a.size());
+  rowsFor(static_cast<int64_t>(a.size()), [&](int64_t i) { partial[i] = a[i].dot(b[i]); });
+  return orderedSum(partial);
+}
+
+CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
+                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w) {
+  const int64_t n = A.rows;
+  w.r.resize(static_cast<size_t>(n));
+  w.c.resize(static_cast<size_t>(n));
+  w.q.resize(static_cast<size_t>(n));
+  w.s.resize(static_cast<size_t>(n));
+  w.precond.resize(static_cast<size_t>(n));
+  w.partial.resize(static_cast<size_t>(n));
+  // block-Jacobi preconditioner P^-1: the inverse of each diagonal block (the first of its row).
+  // delta0 = filter(b)^T P^-1 filter(b) is the scale the residual is measured against.
+  parallelFor(n, [&](int64_t i) {
+    bool ok = false;
+    Eigen::Matrix3d inv;
+    double det = 0.0;
+    A.block[A.rowStart[i]].computeInverseAndDetWithCheck(inv, det, ok, 1e-300);
+    w.precond[i] = ok ? inv : Eigen::Matrix3d::Identity();
+    w.partial[i] = constrained[i] ? 0.0 : b[i].dot(w.precond[i] * b[i]);
+  });
+  double delta0 = orderedSum(w.partial);
+
+  // r = filter(b - A x), c = filter(P^-1 r)
+  rowsFor(n, [&](int64_t i) {
+    if (constrained[i]) {
+      w.r[i].setZero();
+      w.c[i].setZero();
+      w.partial[i] = 0.0;
+      return;
+    }
+    Vec3d ax = Vec3d::Zero();
+    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) ax += A.block[k] * x[A.col[k]];
+    w.r[i] = b[i] - ax;
+    w.c[i] = w.precond[i] * w.r[i];
+    w.partial[i] = w.r[i].dot(w.c[i]);
+  });
+  double deltaNew = orderedSum(w.partial);
+
+  CgResult result;
+  if (!(delta0 > 0.0)) delta0 = deltaNew;
+  if (!(delta0 > 0.0)) {
+    result.converged = true;
+    return result;
+  }
+  const double tol2 = options.tolerance * options.tolerance;
+  while (deltaNew > tol2 * delta0 && result.iterations < options.maxIterations) {
+    // q = filter(A c)
+    rowsFor(n, [&](int64_t i) {
+      if (constrained[i]) {
+        w.q[i].setZero();
+        w.partial[i] = 0.0;
+        return;
+      }
+      Vec3d sum = Vec3d::Zero();
+      for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) sum += A.block[k] * w.c[A.col[k]];
+      w.q[i] = sum;
+      w.partial[i] = w.c[i].dot(sum);
+    });
+    const double cq = orderedSum(w.partial);
+    if (!(cq > 0.0)) {
+      result.breakdown = true;
+      break;
+    }
+    const double alpha = deltaNew / cq;
+    // x += alpha c, r -= alpha q, s = P^-1 r (filtered rows of c, q, r are zero)
+    rowsFor(n, [&](int64_t i) {
+      x[i] += alpha * w.c[i];
+      w.r[i] -= alpha * w.q[i];
+      w.s[i] = constrained[i] ? Vec3d::Zero() : Vec3d(w.precond[i] * w.r[i]);
+      w.partial[i] = w.r[i].dot(w.s[i]);
+    });
+    const double deltaOld = deltaNew;
+    deltaNew = orderedSum(w.partial);
+    const double beta = deltaNew / deltaOld;
+    rowsFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
+    ++result.iterations;
+  }
+  result.residual = std::sqrt(std::max(deltaNew, 0.0) / delta0);
+  result.converged = !result.breakdown && deltaNew <= tol2 * delta0;
+  return result;
+}
+
+}  // namespace soak

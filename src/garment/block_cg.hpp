@@ -1,0 +1,52 @@
+// sparse symmetric matrices of 3x3 blocks (one row per cloth vertex) and the modified
+// preconditioned conjugate gradient of Baraff & Witkin 1998 (section 5.3) that Chen et al. 2012
+// use for Eq. 3-5: constrained vertices are filtered out of every search direction, so the solve
+// never moves them away from their prescribed value. Block-Jacobi preconditioner. Double precision;
+// every sum runs in a fixed order, so the result does not depend on the thread count.
+#pragma once
+#include <soak/math.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace soak {
+
+// block CSR: row i holds blocks [rowStart[i], rowStart[i + 1]); its diagonal block comes first
+struct BlockMatrix {
+  int rows = 0;
+  std::vector<int> rowStart;
+  std::vector<int> col;
+  std::vector<Eigen::Matrix3d> block;
+
+  // y = A x (gather per row)
+  void multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) const;
+};
+
+struct CgOptions {
+  double tolerance = 1e-5;  // stop when sqrt(r^T P^-1 r / b^T P^-1 b) <= tolerance (filtered r, b)
+  int maxIterations = 500;
+};
+
+struct CgResult {
+  int iterations = 0;
+  double residual = 0.0;   // the relative preconditioned residual at exit
+  bool converged = false;
+  bool breakdown = false;  // a direction with c^T A c <= 0: the matrix is not positive definite
+};
+
+struct CgScratch {
+  std::vector<Vec3d> r, c, q, s;
+  std::vector<Eigen::Matrix3d> precond;  // inverse diagonal blocks
+  std::vector<double> partial;           // per-chunk partial sums of the dot products
+};
+
+// solves A x = b for the free rows, with x held at its input value on rows where constrained != 0
+// (Baraff-Witkin's z; the free rows of x are the initial guess). A must be symmetric positive
+// definite on the free rows.
+CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
+                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& scratch);
+
+// deterministic dot product of two block vectors (fixed chunks, partial sums added in order)
+double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::vector<double>& partial);
+
+}  // namespace soak

@@ -1,0 +1,229 @@
+// backward Euler step of Chen et al. 2012 Eq. 1-5 (Baraff & Witkin 1998) with KES springs,
+// Rayleigh damping (Eq. 22-24), filtered constraints and wet-friction contact
+#include "garment/implicit.hpp"
+
+#include <soak/error.hpp>
+
+#include "core/parallel.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+void require(bool ok, const std::string& where, const std::string& key, const std::string& expected, double got) {
+  if (!ok) throw Error(fmt::format("{}.{}: expected {}, got {}", where, key, expected, got));
+}
+
+}  // namespace
+
+void checkGarmentParams(const GarmentParams& p, const std::string& where) {
+  const std::pair<const char*, const KesLaw*> laws[] = {
+      {"stretch", &p.laws.stretch}, {"shear", &p.laws.shear}, {"bend", &p.laws.bend}};
+  for (const auto& [name, law] : laws) {
+    require(law->a1 > 0.0f, where, std::string(name) + ".a1", "a number > 0 (N/m)", law->a1);
+    require(law->a2 >= 0.0f, where, std::string(name) + ".a2", "a number >= 0", law->a2);
+  }
+  require(p.laws.strainLimit > 0.0f && p.laws.strainLimit < 1.0f, where, "strainLimit", "a number in (0, 1)",
+          p.laws.strainLimit);
+  require(p.build.bendStraightness >= 0.0f && p.build.bendStraightness <= 1.0f, where, "bendStraightness",
+          "a number in [0, 1]", p.build.bendStraightness);
+  require(p.saturation.delta >= 0.0f, where, "saturation.delta", "a number >= 0", p.saturation.delta);
+  require(p.saturation.a3 > 0.0f, where, "saturation.a3", "a number > 0", p.saturation.a3);
+  require(p.saturation.timeScale > 0.0f, where, "saturation.timeScale", "a number > 0 (s)", p.saturation.timeScale);
+  const WetFrictionParams& f = p.friction;
+  require(f.dry >= 0.0f, where, "friction.dry", "a number >= 0", f.dry);
+  require(f.peak >= 0.0f, where, "friction.peak", "a number >= 0", f.peak);
+  require(f.plateau >= 0.0f, where, "friction.plateau", "a number >= 0", f.plateau);
+  require(f.tau1 > 0.0f, where, "friction.tau1", "a number > 0", f.tau1);
+  require(f.tau2 > f.tau1, where, "friction.tau2", fmt::format("a number > friction.tau1 ({})", f.tau1), f.tau2);
+  require(f.timeScale > 0.0f, where, "friction.timeScale", "a number > 0 (s)", f.timeScale);
+  require(p.rayleighAlpha >= 0.0f, where, "rayleighAlpha",
+          "a number >= 0 (1/s; a negative alpha adds energy: the paper's -9 is a typo)", p.rayleighAlpha);
+  require(p.rayleighBeta >= 0.0f, where, "rayleighBeta", "a number >= 0 (s)", p.rayleighBeta);
+  require(p.cgTolerance > 0.0f, where, "cgTolerance", "a number > 0", p.cgTolerance);
+  require(p.cgMaxIterations >= 1, where, "cgMaxIterations", "an integer >= 1", p.cgMaxIterations);
+  require(p.wrinkles.compressionThreshold > 0.0f, where, "wrinkles.compressionThreshold", "a number > 0",
+          p.wrinkles.compressionThreshold);
+  require(p.wrinkles.equilibriumSpeed >= 0.0f, where, "wrinkles.equilibriumSpeed", "a number >= 0 (m/s)",
+          p.wrinkles.equilibriumSpeed);
+  require(p.wrinkles.tieTolerance >= 0.0f, where, "wrinkles.tieTolerance", "a number >= 0", p.wrinkles.tieTolerance);
+  require(p.wrinkles.interval >= 1, where, "wrinkles.interval", "an integer >= 1", p.wrinkles.interval);
+  require(p.wrinkles.patchSize >= 3, where, "wrinkles.patchSize", "an integer >= 3", p.wrinkles.patchSize);
+}
+
+GarmentPiece buildGarmentPiece(const Model& model, int piece, const GarmentParams& params) {
+  GarmentPiece g;
+  const ClothPiece& pc = model.pieces[static_cast<size_t>(piece)];
+  g.piece = piece;
+  g.firstParticle = pc.firstParticle;
+  g.count = pc.particleCount;
+  g.springs = buildPieceSprings(model, piece, params.build);
+  const SpringSet& sp = g.springs;
+  g.rowStart.resize(static_cast<size_t>(g.count) + 1);
+  for (int v = 0; v <= g.count; ++v) g.rowStart[v] = sp.vertexStart[v] + v;
+  g.col.resize(static_cast<size_t>(g.rowStart[g.count]));
+  for (int v = 0; v < g.count; ++v) {
+    int k = g.rowStart[v];
+    g.col[k++] = v;
+    for (int e = sp.vertexStart[v]; e < sp.vertexStart[v + 1]; ++e) g.col[k++] = sp.other(sp.vertexSpring[e], v);
+  }
+  std::vector<std::array<int, 3>> tris(static_cast<size_t>(pc.triangleCount));
+  for (int t = 0; t < pc.triangleCount; ++t)
+    for (int k = 0; k < 3; ++k) tris[t][k] = model.triangles[pc.firstTriangle + t][k] - pc.firstParticle;
+  g.subdomains = splitIntoPatches(g.count, tris, params.wrinkles.patchSize);
+  return g;
+}
+
+ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
+                           const std::vector<ColliderPose>& poses, std::span<const float> wetStart,
+                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
+  ImplicitStats stats;
+  const SpringSet& sp = g.springs;
+  const int n = g.count, ns = sp.size();
+  const size_t first = static_cast<size_t>(g.firstParticle);
+  const double hd = h;
+  const double alpha = params.rayleighAlpha, beta = params.rayleighBeta;
+  const double kScale = hd * beta + hd * hd;  // coefficient of K in A: h beta (damping) + h^2 (df/dx)
+  const Vec3d gravity = model.solver.gravity.cast<double>();
+
+  // forces and stiffness per spring (Eq. 12-13), each spring writes only its own slot
+  w.springForce.resize(static_cast<size_t>(ns));
+  w.springStiffness.resize(static_cast<size_t>(ns));
+  w.strain.resize(static_cast<size_t>(ns));
+  parallelFor(ns, [&](int64_t s) {
+    w.strain[s] = springForce(sp, params.laws, static_cast<int>(s), p.x[first + sp.ids[s][0]], p.x[first + sp.ids[s][1]],
+                              w.springForce[s], &w.springStiffness[s]);
+  });
+  if (sp.kindStart[1] > 0) {
+    const auto [lo, hi] = std::minmax_element(w.strain.begin(), w.strain.begin() + sp.kindStart[1]);
+    stats.minStrain = *lo;
+    stats.maxStrain = *hi;
+  }
+
+  // constrained rows: pinned vertices stay (dv = -v0), disturbed vertices reach their target
+  w.constrained.assign(static_cast<size_t>(n), 0);
+  w.dv.assign(static_cast<size_t>(n), Vec3d::Zero());
+  for (int v = 0; v < n; ++v)
+    if (model.clothPinned[first + v]) {
+      w.constrained[v] = 1;
+      w.dv[v] = -p.v[first + v].cast<double>();
+    }
+  for (const PositionConstraint& c : constraints) {
+    if (c.vertex < 0 || c.vertex >= n || w.constrained[c.vertex] == 1) continue;
+    w.constrained[c.vertex] = 2;
+    const size_t i = first + c.vertex;
+    w.dv[c.vertex] = ((c.target - p.x[i]).cast<double>() / hd) - p.v[i].cast<double>();
+  }
+  for (uint8_t c : w.constrained) stats.constrainedVertices += c ? 1 : 0;
+
+  // A = M (1 + h alpha) + (h beta + h^2) K, b = h (f0 + h df/dx v0), gathered per row (Eq. 3-4)
+  w.A.rows = n;
+  w.A.rowStart = g.rowStart;
+  w.A.col = g.col;
+  w.A.block.resize(g.col.size());
+  w.rhs.resize(static_cast<size_t>(n));
+  parallelFor(n, [&](int64_t v) {
+    const size_t i = first + static_cast<size_t>(v);
+    const double m = p.mass[i];
+    const Vec3d v0 = p.v[i].cast<double>();
+    Vec3d f = m * gravity - alpha * m * v0;  // gravity and the mass part of the damping (Eq. 24)
+    Eigen::Matrix3d kDiag = Eigen::Matrix3d::Zero();
+    Vec3d kv = Vec3d::Zero();  // (K v0)_v
+    int slot = g.rowStart[v] + 1;
+    for (int e = sp.vertexStart[v]; e < sp.vertexStart[v + 1]; ++e, ++slot) {
+      const int s = sp.vertexSpring[e];
+      const int o = sp.other(s, static_cast<int>(v));
+      const Eigen::Matrix3d& K = w.springStiffness[s];
+      f += (sp.ids[s][0] == v) ? w.springForce[s] : Vec3d(-w.springForce[s]);
+      kDiag += K;
+      kv += K * (v0 - p.v[first + o].cast<double>());
+      w.A.block[slot] = -kScale * K;
+    }
+    w.A.block[g.rowStart[v]] = (m * (1.0 + hd * alpha)) * Eigen::Matrix3d::Identity() + kScale * kDiag;
+    // f0 includes the stiffness damping -beta K v0; h df/dx v0 = -h K v0
+    w.rhs[v] = hd * (f - (beta + hd) * kv);
+  });
+
+  CgOptions opt;
+  opt.tolerance = params.cgTolerance;
+  opt.maxIterations = params.cgMaxIterations;
+  const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg);
+  stats.cgIterations = cg.iterations;
+  stats.cgResidual = cg.residual;
+  stats.converged = cg.converged;
+  stats.breakdown = cg.breakdown;
+
+  // v1 = v0 + dv, x1 = x0 + h v1; then contact with the colliders at time + h
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
+  const double tEnd = time + hd;
+  std::vector<uint8_t>& touched = w.constrained;  // reused: 3 = in contact this step
+  parallelFor(n, [&](int64_t v) {
+    const size_t i = first + static_cast<size_t>(v);
+    if (w.constrained[v] == 1) {  // pinned: never moves
+      p.xPred[i] = p.x[i];
+      p.v[i].setZero();
+      return;
+    }
+    Vec3 vel = (p.v[i].cast<double>() + w.dv[v]).cast<float>();
+    Vec3 x = p.x[i] + h * vel;
+    if (w.constrained[v] == 2) {  // disturbed: reaches its target exactly
+      p.xPred[i] = x;
+      p.v[i] = vel;
+      return;
+    }
+    const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
+    const float muFabric = wetFriction(tEnd - static_cast<double>(start), params.friction);
+    bool contact = false;
+    for (size_t c = 0; c < numColliders; ++c) {
+      Vec3 nrm;
+      const float d = colliderDistance(model.colliders[c], poses[c], x, &nrm) - margin;
+      if (d >= 0.0f) continue;
+      contact = true;
+      x -= d * nrm;  // project out to the margin
+      const Vec3 vCol = poses[c].velocityAt(x);
+      Vec3 rel = vel - vCol;
+      const float vn = rel.dot(nrm);
+      const float dvn = std::max(-vn, 0.0f);
+      rel += dvn * nrm;  // the inward velocity is removed
+      const Vec3 after = coulombFriction(rel, nrm, mixFriction(muFabric, model.colliders[c].friction), dvn);
+      x += h * (after - rel);  // friction acted during the step: the slip it removed is not travelled
+      vel = vCol + after;
+    }
+    p.xPred[i] = x;
+    p.v[i] = vel;
+    if (contact) touched[v] = 3;
+  });
+  for (uint8_t c : touched) stats.contacts += c == 3 ? 1 : 0;
+  return stats;
+}
+
+ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
+                             std::span<const float> wetStart, double time, float h, uint64_t stepIndex,
+                             const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch) {
+  if (params.saturationMass) applySaturationMass(model, g.piece, wetStart, time, params.saturation, p);  // Eq. 15-19
+  const std::vector<PositionConstraint> wrinkles =
+      computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses, params.wrinkles, stepIndex);  // 3.5
+  ImplicitStats s = implicitStep(model, g, params, time, h, poses, wetStart, wrinkles, p, scratch);      // Eq. 1-5
+  s.disturbances = static_cast<int>(wrinkles.size());
+  return s;
+}
+
+double garmentEnergy(const Model& model, const GarmentPiece& g, const GarmentParams& params, const Particles& p) {
+  const size_t first = static_cast<size_t>(g.firstParticle);
+  const Vec3d gravity = model.solver.gravity.cast<double>();
+  double e = elasticEnergy(g.springs, params.laws, p.x.data() + first);
+  for (int v = 0; v < g.count; ++v) {
+    const size_t i = first + static_cast<size_t>(v);
+    const double m = p.mass[i];
+    e += 0.5 * m * p.v[i].cast<double>().squaredNorm() - m * gravity.dot(p.x[i].cast<double>());
+  }
+  return e;
+}
+
+}  // namespace soak

@@ -1,0 +1,91 @@
+// implicit mass-spring cloth of Chen, Magnenat-Thalmann, Allen 2012 (section 3.1, Eq. 1-5): one
+// backward Euler step linearised once (Baraff & Witkin 1998),
+//   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),   v1 = v0 + dv,   x1 = x0 + h v1,
+// with the KES springs of springs.hpp, gravity, Rayleigh damping D = alpha M + beta K (Eq. 22-24),
+// the saturation mass of Eq. 15-19 (read from Particles::mass), pinned vertices and temporary
+// position constraints (wrinkles.hpp) enforced by the filtered PCG of block_cg.hpp, and, after the
+// solve, collider contact with the wet friction of Fig. 5 (wet_friction.hpp).
+//
+// Use from the step, for a piece whose scene says "solver": "implicit" (docs/garment.md): one call
+//   ImplicitStats s = garmentSubstep(model, g, params, wetStart, time, h, stepIndex, poses, p, scratch);
+// which is
+//   applySaturationMass(model, k, wetStart, time, params.saturation, p);      // Eq. 15-19
+//   auto wr = computeDisturbances(model, k, g.springs, g.subdomains, p, poses, params.wrinkles, step);
+//   implicitStep(model, g, params, time, h, poses, wetStart, wr, p, scratch);  // Eq. 1-5, contact
+// It reads x, v, mass of the piece and writes xPred (= x1) and v (= v1); x is left for the caller's
+// commit (x = xPred). The PBD stages must skip the piece: no predictPositions, solveCloth,
+// updateVelocities for it.
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+#include "garment/block_cg.hpp"
+#include "garment/saturation_mass.hpp"
+#include "garment/springs.hpp"
+#include "garment/wet_friction.hpp"
+#include "garment/wrinkles.hpp"
+#include "world/colliders.hpp"
+
+#include <span>
+#include <string>
+#include <vector>
+
+namespace soak {
+
+// throws soak::Error "<where>.<key>: expected ..., got ..." for the first parameter out of its range
+// (a1 > 0, a2 >= 0, 0 < strainLimit < 1, a3 > 0, 0 < tau1 < tau2, alpha >= 0, beta >= 0, ...)
+void checkGarmentParams(const GarmentParams& params, const std::string& where);
+
+// the constant data of a piece solved implicitly: springs, the system's block pattern, subdomains
+struct GarmentPiece {
+  int piece = -1;
+  int firstParticle = 0, count = 0;
+  SpringSet springs;
+  // row v of the system: [rowStart[v], rowStart[v + 1]): the diagonal, then one block per spring of v
+  // in springs.vertexSpring order
+  std::vector<int> rowStart, col;
+  std::vector<std::vector<int>> subdomains;  // piece-local vertex sets for the wrinkle model
+};
+
+// builds the garment data of model.pieces[piece]; subdomains are connected patches of
+// params.wrinkles.patchSize vertices (the garment's panels, where the mesh has no panel data)
+GarmentPiece buildGarmentPiece(const Model& model, int piece, const GarmentParams& params);
+
+struct ImplicitScratch {
+  BlockMatrix A;
+  CgScratch cg;
+  std::vector<Vec3d> springForce;              // N, on ids[s][0]
+  std::vector<Eigen::Matrix3d> springStiffness;
+  std::vector<float> strain;
+  std::vector<Vec3d> rhs, dv;
+  std::vector<uint8_t> constrained;
+};
+
+struct ImplicitStats {
+  int cgIterations = 0;
+  double cgResidual = 0.0;   // relative, at exit
+  bool converged = true;     // false: the CG hit cgMaxIterations (or broke down); the step still ran
+  bool breakdown = false;    // the system was not positive definite
+  int constrainedVertices = 0;  // pinned + disturbed
+  int contacts = 0;             // vertices pushed out of a collider
+  int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)
+  float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
+};
+
+// one implicit step of length h for the piece (see the header comment). wetStart (piece-local,
+// empty = all dry) sets each vertex's friction with wetFriction(time + h - wetStart); poses are the
+// colliders at time + h. Deterministic for any thread count.
+ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
+                           const std::vector<ColliderPose>& poses, std::span<const float> wetStart,
+                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& scratch);
+
+// the garment stage of one piece for one step of length h starting at `time` (see the header
+// comment); stepIndex paces the wrinkle disturbances
+ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
+                             std::span<const float> wetStart, double time, float h, uint64_t stepIndex,
+                             const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch);
+
+// kinetic + gravitational + elastic energy of the piece (J), for tests and diagnostics
+double garmentEnergy(const Model& model, const GarmentPiece& g, const GarmentParams& params, const Particles& p);
+
+}  // namespace soak

@@ -1,0 +1,263 @@
+// springs of Chen et al. 2012 section 3.2 and their KES force laws (Eq. 9-14)
+#include "garment/springs.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+int64_t pairKey(int a, int b) {
+  const int lo = std::min(a, b), hi = std::max(a, b);
+  return (static_cast<int64_t>(lo) << 32) | static_cast<int64_t>(static_cast<uint32_t>(hi));
+}
+
+struct Candidate {
+  int64_t key;
+  int a, b;
+  float area;  // m^2, S_r of Eq. 6/9
+};
+
+// sorts by key and keeps the first of each key that is not in `taken` (sorted keys)
+std::vector<Candidate> uniqueNotIn(std::vector<Candidate> c, const std::vector<int64_t>& taken) {
+  std::stable_sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) { return x.key < y.key; });
+  std::vector<Candidate> out;
+  for (const Candidate& x : c) {
+    if (!out.empty() && out.back().key == x.key) continue;
+    if (std::binary_search(taken.begin(), taken.end(), x.key)) continue;
+    out.push_back(x);
+  }
+  return out;
+}
+
+struct HalfEdge {
+  int64_t key;
+  int opposite;   // third vertex of the triangle
+  int triangle;
+};
+
+}  // namespace
+
+SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::array<int, 3>>& triangles,
+                       const SpringBuildOptions& options) {
+  const int n = static_cast<int>(rest.size());
+  std::vector<double> triArea(triangles.size());
+  std::vector<HalfEdge> half;
+  half.reserve(triangles.size() * 3);
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const Vec3d a = rest[tri[0]].cast<double>(), b = rest[tri[1]].cast<double>(), c = rest[tri[2]].cast<double>();
+    triArea[t] = 0.5 * (b - a).cross(c - a).norm();
+    for (int k = 0; k < 3; ++k) half.push_back({pairKey(tri[k], tri[(k + 1) % 3]), tri[(k + 2) % 3], int(t)});
+  }
+  std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
+    return x.key != y.key ? x.key < y.key : x.triangle < y.triangle;
+  });
+
+  // stretch: unique edges, each with a third of the area of its triangles
+  std::vector<Candidate> stretch, shear, bend;
+  for (size_t s = 0; s < half.size();) {
+    size_t e = s;
+    double area = 0.0;
+    while (e < half.size() && half[e].key == half[s].key) area += triArea[half[e++].triangle] / 3.0;
+    const int a = static_cast<int>(half[s].key >> 32), b = static_cast<int>(half[s].key & 0xffffffff);
+    stretch.push_back({half[s].key, a, b, static_cast<float>(area)});
+    // shear: the opposite vertices across an interior edge, with the edge's area share
+    if (e - s == 2 && half[s].opposite != half[s + 1].opposite)
+      shear.push_back({pairKey(half[s].opposite, half[s + 1].opposite), half[s].opposite, half[s + 1].opposite,
+                       static_cast<float>(area)});
+    s = e;
+  }
+  std::vector<int64_t> taken;
+  for (const Candidate& c : stretch) taken.push_back(c.key);  // already sorted and unique
+
+  // 1-ring with the index of the stretch spring of each edge, for the bend springs
+  std::vector<std::vector<std::pair<int, int>>> ring(n);
+  for (int k = 0; k < static_cast<int>(stretch.size()); ++k) {
+    ring[stretch[k].a].push_back({stretch[k].b, k});
+    ring[stretch[k].b].push_back({stretch[k].a, k});
+  }
+  for (auto& r : ring) std::sort(r.begin(), r.end());
+  for (int a = 0; a < n; ++a) {
+    for (const auto& [b, ab] : ring[a]) {
+      const Vec3d dir = (rest[b] - rest[a]).cast<double>().normalized();
+      int best = -1, bestEdge = -1;
+      double bestCos = options.bendStraightness;
+      for (const auto& [c, bc] : ring[b]) {
+        if (c == a) continue;
+        const double cosTurn = dir.dot((rest[c] - rest[b]).cast<double>().normalized());
+        if (cosTurn >= bestCos && (best < 0 || cosTurn > bestCos)) {
+          best = c;
+          bestEdge = bc;
+          bestCos = cosTurn;
+        }
+      }
+      if (best >= 0 && best != a)
+        bend.push_back({pairKey(a, best), a, best, 0.5f * (stretch[ab].area + stretch[bestEdge].area)});
+    }
+  }
+  // a pair that is both a straight skip-one pair and a pair across an edge is a bend spring
+  bend = uniqueNotIn(std::move(bend), taken);
+  for (const Candidate& c : bend) taken.push_back(c.key);
+  std::sort(taken.begin(), taken.end());
+  shear = uniqueNotIn(std::move(shear), taken);
+
+  SpringSet out;
+  out.numVertices = n;
+  const std::vector<Candidate>* kinds[3] = {&stretch, &shear, &bend};
+  for (int k = 0; k < 3; ++k) {
+    out.kindStart[k] = out.size();
+    for (const Candidate& c : *kinds[k]) {
+      const int lo = std::min(c.a, c.b), hi = std::max(c.a, c.b);
+      const float l0 = (rest[hi] - rest[lo]).norm();
+      out.ids.push_back({lo, hi});
+      out.restLength.push_back(l0);
+      out.width.push_back(l0 > 0.0f ? c.area / l0 : 0.0f);
+    }
+  }
+  out.kindStart[3] = out.size();
+
+  out.vertexStart.assign(n + 1, 0);
+  for (const auto& id : out.ids) {
+    ++out.vertexStart[id[0] + 1];
+    ++out.vertexStart[id[1] + 1];
+  }
+  for (int v = 0; v < n; ++v) out.vertexStart[v + 1] += out.vertexStart[v];
+  out.vertexSpring.assign(out.vertexStart[n], 0);
+  std::vector<int> fill(out.vertexStart.begin(), out.vertexStart.end() - 1);
+  for (int s = 0; s < out.size(); ++s) {
+    out.vertexSpring[fill[out.ids[s][0]]++] = s;
+    out.vertexSpring[fill[out.ids[s][1]]++] = s;
+  }
+  return out;
+}
+
+SpringSet buildPieceSprings(const Model& model, int piece, const SpringBuildOptions& options) {
+  const ClothPiece& pc = model.pieces[static_cast<size_t>(piece)];
+  std::vector<Vec3> rest(model.clothRestPosition.begin() + pc.firstParticle,
+                         model.clothRestPosition.begin() + pc.firstParticle + pc.particleCount);
+  std::vector<std::array<int, 3>> tris(static_cast<size_t>(pc.triangleCount));
+  for (int t = 0; t < pc.triangleCount; ++t)
+    for (int k = 0; k < 3; ++k) tris[t][k] = model.triangles[pc.firstTriangle + t][k] - pc.firstParticle;
+  return buildSprings(rest, tris, options);
+}
+
+float kesStretchStress(float eps, const KesLaw& law, float strainLimit, float* dsigma) {
+  const float a = std::abs(eps);
+  const float sign = eps < 0.0f ? -1.0f : 1.0f;
+  // Eq. 11 and its derivative Eq. 13: sigma' = a1 (1 + 2 a2 |eps|) / (1 - a2 |eps|)^4
+  auto law11 = [&](float e, float* d) {
+    const float q = 1.0f - law.a2 * e;
+    const float q3 = q * q * q;
+    *d = law.a1 * (1.0f + 2.0f * law.a2 * e) / (q3 * q);
+    return law.a1 * e / q3;
+  };
+  if (law.a2 > 0.0f) {
+    const float ec = strainLimit / law.a2;
+    if (a > ec) {
+      float dc;
+      const float sc = law11(ec, &dc);
+      if (dsigma) *dsigma = dc;
+      return sign * (sc + dc * (a - ec));
+    }
+  }
+  float d;
+  const float s = law11(a, &d);
+  if (dsigma) *dsigma = d;
+  return sign * s;
+}
+
+float kesBendStress(float eps, const KesLaw& law, float* dsigma) {
+  const float a = std::abs(eps);
+  if (dsigma) *dsigma = law.a1 + 2.0f * law.a2 * a;
+  return law.a1 * eps + law.a2 * eps * a;  // Eq. 14
+}
+
+double kesStretchEnergy(double eps, const KesLaw& law, float strainLimit) {
+  const double a = std::abs(eps);
+  auto w = [&](double e) {
+    const double q = 1.0 - law.a2 * e;
+    return law.a1 * e * e / (2.0 * q * q);
+  };
+  if (law.a2 > 0.0f) {
+    const double ec = static_cast<double>(strainLimit) / law.a2;
+    if (a > ec) {
+      const double q = 1.0 - law.a2 * ec;
+      const double sc = law.a1 * ec / (q * q * q);
+      const double dc = law.a1 * (1.0 + 2.0 * law.a2 * ec) / (q * q * q * q);
+      const double r = a - ec;
+      return w(ec) + sc * r + 0.5 * dc * r * r;
+    }
+  }
+  return w(a);
+}
+
+double kesBendEnergy(double eps, const KesLaw& law) {
+  const double a = std::abs(eps);
+  return 0.5 * law.a1 * a * a + law.a2 * a * a * a / 3.0;
+}
+
+float springStress(const SpringSet& springs, const SpringLaws& laws, int s, float eps, float* dsigma) {
+  switch (springs.kind(s)) {
+    case SpringKind::Stretch:
+      return kesStretchStress(eps, laws.stretch, laws.strainLimit, dsigma);
+    case SpringKind::Shear:
+      return kesStretchStress(eps, laws.shear, laws.strainLimit, dsigma);
+    case SpringKind::Bend:
+      return kesBendStress(eps, laws.bend, dsigma);
+  }
+  return 0.0f;
+}
+
+float springForce(const SpringSet& springs, const SpringLaws& laws, int s, const Vec3& xi, const Vec3& xj, Vec3d& fi,
+                  Eigen::Matrix3d* K) {
+  const double l0 = springs.restLength[s];
+  const double L0 = springs.width[s];
+  const Vec3d d = (xj - xi).cast<double>();
+  const double l = d.norm();
+  if (!(l > 1e-12 * l0) || !(l0 > 0.0)) {
+    // coincident ends: no direction, no force; the spring keeps only its axial stiffness isotropically
+    fi.setZero();
+    if (K) {
+      float ds = 0.0f;
+      springStress(springs, laws, s, -1.0f, &ds);
+      *K = (L0 * ds / l0) * Eigen::Matrix3d::Identity();
+    }
+    return -1.0f;
+  }
+  const Vec3d u = d / l;
+  const float eps = static_cast<float>((l - l0) / l0);  // Eq. 7-8
+  float ds = 0.0f;
+  const double sigma = springStress(springs, laws, s, eps, &ds);
+  fi = (L0 * sigma) * u;  // Eq. 12
+  if (K) {
+    const Eigen::Matrix3d uu = u * u.transpose();
+    *K = L0 * ((ds / l0) * uu + (std::max(sigma, 0.0) / l) * (Eigen::Matrix3d::Identity() - uu));
+  }
+  return eps;
+}
+
+double elasticEnergy(const SpringSet& springs, const SpringLaws& laws, const Vec3* x) {
+  double e = 0.0;
+  for (int s = 0; s < springs.size(); ++s) {
+    const double l0 = springs.restLength[s];
+    const double eps = ((x[springs.ids[s][1]] - x[springs.ids[s][0]]).cast<double>().norm() - l0) / l0;
+    double w = 0.0;
+    switch (springs.kind(s)) {
+      case SpringKind::Stretch:
+        w = kesStretchEnergy(eps, laws.stretch, laws.strainLimit);
+        break;
+      case SpringKind::Shear:
+        w = kesStretchEnergy(eps, laws.shear, laws.strainLimit);
+        break;
+      case SpringKind::Bend:
+        w = kesBendEnergy(eps, laws.bend);
+        break;
+    }
+    e += springs.width[s] * l0 * w;
+  }
+  return e;
+}
+
+}  // namespace soak

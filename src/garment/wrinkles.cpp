@@ -1,0 +1,259 @@
+// Chen et al. 2012 section 3.5: wrinkle disturbances from the most compressed spring (Eq. 25-26)
+#include "garment/wrinkles.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+namespace soak {
+
+namespace {
+
+uint64_t splitmix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+bool insideCollider(const Model& model, const std::vector<ColliderPose>& poses, const Vec3& x, float margin) {
+  const size_t n = std::min(model.colliders.size(), poses.size());
+  for (size_t c = 0; c < n; ++c)
+    if (colliderDistance(model.colliders[c], poses[c], x, nullptr) < margin) return true;
+  return false;
+}
+
+}  // namespace
+
+SphereIntersection intersectThreeSpheres(const Vec3& c1, float r1, const Vec3& c2, float r2, const Vec3& c3, float r3,
+                                         float tolerance) {
+  // Eq. 25 in the frame ex = (c2 - c1)/d, ey in the plane of the centres, ez = ex x ey
+  SphereIntersection out;
+  const Vec3d p1 = c1.cast<double>(), p2 = c2.cast<double>(), p3 = c3.cast<double>();
+  const double d = (p2 - p1).norm();
+  const double scale = std::max({d, (p3 - p1).norm(), 1e-30});
+  if (!(d > 1e-9 * scale)) {
+    out.degenerate = true;
+    return out;
+  }
+  const Vec3d ex = (p2 - p1) / d;
+  const double i = ex.dot(p3 - p1);
+  const Vec3d rest = (p3 - p1) - i * ex;
+  const double j = rest.norm();
+  if (!(j > 1e-9 * scale)) {
+    out.degenerate = true;
+    return out;
+  }
+  const Vec3d ey = rest / j;
+  const Vec3d ez = ex.cross(ey);
+  const double R1 = r1, R2 = r2, R3 = r3;
+  const double x = (R1 * R1 - R2 * R2 + d * d) / (2.0 * d);
+  const double y = (R1 * R1 - R3 * R3 + i * i + j * j) / (2.0 * j) - (i / j) * x;
+  const double z2 = R1 * R1 - x * x - y * y;
+  const Vec3d base = p1 + x * ex + y * ey;
+  const double tol = std::max(static_cast<double>(tolerance), 0.0);
+  if (z2 < 0.0) {
+    // the spheres miss each other, unless sphere 1 grown by the tolerance would reach (one tangent point)
+    if (-z2 > 2.0 * R1 * tol + tol * tol) return out;
+    out.count = 1;
+    out.point[0] = base.cast<float>();
+    return out;
+  }
+  const double z = std::sqrt(z2);
+  if (z <= tol) {
+    out.count = 1;
+    out.point[0] = base.cast<float>();
+    return out;
+  }
+  out.count = 2;
+  out.point[0] = (base + z * ez).cast<float>();
+  out.point[1] = (base - z * ez).cast<float>();
+  return out;
+}
+
+float disturbanceCurvature(const Vec3& candidate, const Vec3& b, const Vec3& d) {
+  const Vec3d v1 = (b - candidate).cast<double>(), v2 = (candidate - d).cast<double>();
+  const double n1 = v1.norm(), n2 = v2.norm();
+  if (!(n1 > 0.0) || !(n2 > 0.0)) return 0.0f;
+  const double c = std::clamp(v1.dot(v2) / (n1 * n2), -1.0, 1.0);
+  return static_cast<float>(2.0 / (n1 + n2) * std::acos(c));  // Eq. 26
+}
+
+int chooseDisturbance(const Vec3& a, const SphereIntersection& hits, const std::array<bool, 2>& collides,
+                      const Vec3& b, const Vec3& d, float tieDistance, int coin) {
+  if (hits.count <= 0) return -1;
+  if (hits.count == 1) return collides[0] ? -1 : 0;  // step 2
+  if (collides[0] && collides[1]) return -1;          // step 3
+  if (collides[0]) return 1;
+  if (collides[1]) return 0;
+  const float d0 = (hits.point[0] - a).norm(), d1 = (hits.point[1] - a).norm();  // step 4
+  if (std::abs(d0 - d1) > tieDistance) return d0 < d1 ? 0 : 1;
+  const float k0 = disturbanceCurvature(hits.point[0], b, d), k1 = disturbanceCurvature(hits.point[1], b, d);
+  if (std::abs(k0 - k1) > 1e-4f * std::max(std::abs(k0), std::abs(k1))) return k0 > k1 ? 0 : 1;  // steps 5-6
+  return coin & 1;
+}
+
+std::vector<PositionConstraint> computeDisturbances(const Model& model, int piece, const SpringSet& springs,
+                                                    const std::vector<std::vector<int>>& subdomains,
+                                                    const Particles& p, const std::vector<ColliderPose>& poses,
+                                                    const WrinkleParams& params, uint64_t stepIndex) {
+  std::vector<PositionConstraint> out;
+  if (!params.enabled || params.interval < 1 || stepIndex % static_cast<uint64_t>(params.interval) != 0) return out;
+  const ClothPiece& pc = model.pieces[static_cast<size_t>(piece)];
+  const int first = pc.firstParticle;
+  const float margin = contactMargin(model, static_cast<int32_t>(piece + 1));
+  const int stretchEnd = springs.kindStart[1];
+  auto pos = [&](int v) -> const Vec3& { return p.x[static_cast<size_t>(first + v)]; };
+  auto pinned = [&](int v) { return model.clothPinned[static_cast<size_t>(first + v)] != 0; };
+  auto strain = [&](int s) {
+    const float l0 = springs.restLength[s];
+    return ((pos(springs.ids[s][1]) - pos(springs.ids[s][0])).norm() - l0) / l0;
+  };
+  // stretch springs of v, in spring order
+  auto stretchOf = [&](int v, std::vector<int>& list) {
+    list.clear();
+    for (int k = springs.vertexStart[v]; k < springs.vertexStart[v + 1]; ++k)
+      if (springs.vertexSpring[k] < stretchEnd) list.push_back(springs.vertexSpring[k]);
+  };
+  std::vector<int> owner(static_cast<size_t>(springs.numVertices), -1);
+  for (size_t k = 0; k < subdomains.size(); ++k)
+    for (int v : subdomains[k]) owner[static_cast<size_t>(v)] = static_cast<int>(k);
+
+  std::vector<int> list;
+  for (size_t k = 0; k < subdomains.size(); ++k) {
+    const std::vector<int>& dom = subdomains[k];
+    if (dom.empty()) continue;
+    // near equilibrium: the system energy (here the RMS speed) is low enough
+    double v2 = 0.0;
+    for (int v : dom) v2 += p.v[static_cast<size_t>(first + v)].squaredNorm();
+    if (std::sqrt(v2 / static_cast<double>(dom.size())) > params.equilibriumSpeed) continue;
+    // the most compressed stretch spring inside the subdomain (lowest index on ties)
+    int best = -1;
+    float bestEps = -params.compressionThreshold;
+    for (int v : dom) {
+      stretchOf(v, list);
+      for (int s : list) {
+        if (owner[springs.ids[s][0]] != static_cast<int>(k) || owner[springs.ids[s][1]] != static_cast<int>(k)) continue;
+        const float e = strain(s);
+        if (e < bestEps || (e == bestEps && best >= 0 && s < best)) {
+          best = s;
+          bestEps = e;
+        }
+      }
+    }
+    if (best < 0) continue;
+    // A: the free end whose stretch springs are more compressed on average
+    auto meanStrain = [&](int v) {
+      stretchOf(v, list);
+      float sum = 0.0f;
+      for (int s : list) sum += strain(s);
+      return list.empty() ? 0.0f : sum / static_cast<float>(list.size());
+    };
+    int a = springs.ids[best][0], b = springs.ids[best][1];
+    if (pinned(a) || (!pinned(b) && meanStrain(b) < meanStrain(a))) std::swap(a, b);
+    if (pinned(a)) continue;
+    // C, D: A's other stretch neighbours, most compressed first, with B, C, D not collinear
+    stretchOf(a, list);
+    std::vector<std::pair<float, int>> others;
+    for (int s : list)
+      if (s != best) others.push_back({strain(s), s});
+    std::sort(others.begin(), others.end());
+    const float l0ab = springs.restLength[best];
+    int sc = -1, sd = -1;
+    for (size_t u = 0; u < others.size() && sc < 0; ++u)
+      for (size_t w = u + 1; w < others.size(); ++w) {
+        const Vec3 c = pos(springs.other(others[u].second, a)), d = pos(springs.other(others[w].second, a));
+        if ((c - pos(b)).cross(d - pos(b)).norm() > 0.05f * l0ab * l0ab) {
+          sc = others[u].second;
+          sd = others[w].second;
+          break;
+        }
+      }
+    if (sc < 0) continue;
+    const int c = springs.other(sc, a), d = springs.other(sd, a);
+    // Eq. 25: where all three springs would be at rest length
+    const SphereIntersection hits = intersectThreeSpheres(pos(b), l0ab, pos(c), springs.restLength[sc], pos(d),
+                                                          springs.restLength[sd], 1e-4f * l0ab);
+    if (hits.count == 0) continue;
+    std::array<bool, 2> collides{false, false};
+    for (int h = 0; h < hits.count; ++h) collides[h] = insideCollider(model, poses, hits.point[h], margin);
+    const int coin = static_cast<int>(splitmix(splitmix(params.seed ^ (uint64_t(piece) << 32)) ^ (uint64_t(a) << 20) ^
+                                               stepIndex) & 1u);
+    const int pick = chooseDisturbance(pos(a), hits, collides, pos(b), pos(d), params.tieTolerance * l0ab, coin);
+    if (pick >= 0) out.push_back({a, hits.point[pick]});
+  }
+  return out;
+}
+
+std::vector<std::vector<int>> splitIntoPatches(int numVertices, const std::vector<std::array<int, 3>>& triangles,
+                                               int targetSize) {
+  const int n = std::max(numVertices, 0);
+  const int target = std::max(targetSize, 1);
+  std::vector<std::vector<int>> adj(static_cast<size_t>(n));
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      adj[t[k]].push_back(t[(k + 1) % 3]);
+      adj[t[(k + 1) % 3]].push_back(t[k]);
+    }
+  for (auto& a : adj) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+  // breadth-first growth, target vertices per patch
+  std::vector<int> patch(static_cast<size_t>(n), -1);
+  std::vector<int> size;
+  std::deque<int> queue;
+  for (int seed = 0; seed < n; ++seed) {
+    if (patch[seed] >= 0) continue;
+    const int id = static_cast<int>(size.size());
+    size.push_back(0);
+    queue.assign(1, seed);
+    patch[seed] = id;
+    while (!queue.empty() && size[id] < target) {
+      const int v = queue.front();
+      queue.pop_front();
+      ++size[id];
+      for (int w : adj[v])
+        if (patch[w] < 0 && size[id] + static_cast<int>(queue.size()) < target) {
+          patch[w] = id;
+          queue.push_back(w);
+        }
+    }
+    for (int v : queue) patch[v] = -1;  // claimed but not reached: released for the next patch
+    queue.clear();
+  }
+  // merge patches under half the target into their smallest neighbouring patch
+  std::vector<int> parent(size.size());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto root = [&](int x) {
+    while (parent[x] != x) x = parent[x];
+    return x;
+  };
+  for (int id = 0; id < static_cast<int>(size.size()); ++id) {
+    if (root(id) != id || size[id] * 2 >= target) continue;
+    int into = -1;
+    for (int v = 0; v < n; ++v) {
+      if (root(patch[v]) != id) continue;
+      for (int w : adj[v]) {
+        const int r = root(patch[w]);
+        if (r != id && (into < 0 || size[r] < size[into] || (size[r] == size[into] && r < into))) into = r;
+      }
+    }
+    if (into < 0) continue;  // an isolated component: stays on its own
+    parent[id] = into;
+    size[into] += size[id];
+  }
+  std::vector<int> label(size.size(), -1);
+  std::vector<std::vector<int>> out;
+  for (int v = 0; v < n; ++v) {
+    const int r = root(patch[v]);
+    if (label[r] < 0) {
+      label[r] = static_cast<int>(out.size());
+      out.emplace_back();
+    }
+    out[label[r]].push_back(v);
+  }
+  return out;
+}
+
+}  // namespace soak

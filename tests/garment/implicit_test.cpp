@@ -1,0 +1,335 @@
+// the implicit garment solver (Chen 2012 Eq. 1-5 after Baraff & Witkin 1998): filtered PCG,
+// stability at a large step where explicit Euler diverges, pinned vertices, reported CG failure,
+// collider contact with wet friction, determinism
+#include "garment/implicit.hpp"
+
+#include <soak/error.hpp>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "pbd/cloth.hpp"
+
+namespace soak {
+namespace {
+
+struct Rig {
+  Model model;
+  Particles p;
+  GarmentParams params;
+  GarmentPiece g;
+  ImplicitScratch scratch;
+  std::vector<ColliderPose> poses;
+};
+
+// a horizontal res x res sheet of `size` m at height y, pinned at the two corners of its first row
+void makeHangingRig(Rig& r, int res, float size, float y, std::vector<int> pins) {
+  const TriangleMesh mesh = makeRectangle(Vec3(0, y, 0), Vec3::UnitX(), Vec3::UnitZ(), size, size, res, res);
+  addClothPiece(r.model, "sheet", mesh, ClothMaterial{}, pins, "<test>");
+  for (int i = 0; i < r.model.numCloth; ++i) {
+    r.p.add(1, uint32_t(i), r.model.clothDryMass[i], 0.04f, r.model.clothRestPosition[i], Vec3::Zero());
+    if (r.model.clothPinned[i]) r.p.invMass.back() = 0.0f;
+  }
+  r.g = buildGarmentPiece(r.model, 0, r.params);
+}
+
+ImplicitStats stepRig(Rig& r, double t, float h, const std::vector<PositionConstraint>& constraints = {},
+                      const std::vector<float>& wetStart = {}) {
+  r.poses.resize(r.model.colliders.size());
+  for (size_t c = 0; c < r.model.colliders.size(); ++c) r.poses[c] = colliderPose(r.model.colliders[c], t + h);
+  const ImplicitStats s = implicitStep(r.model, r.g, r.params, t, h, r.poses, wetStart, constraints, r.p, r.scratch);
+  r.p.x = r.p.xPred;  // the caller's commit
+  return s;
+}
+
+TEST(GarmentCg, FilteredPcgSolvesFreeRowsAndKeepsConstrainedRows) {
+  // a random SPD 3x3-block tridiagonal matrix of 6 rows
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 6;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int i = 0; i + 1 < n; ++i) {
+    Eigen::Matrix3d b;
+    for (int k = 0; k < 9; ++k) b(k / 3, k % 3) = u(rng);
+    dense.block<3, 3>(3 * i, 3 * i + 3) = b;
+    dense.block<3, 3>(3 * i + 3, 3 * i) = b.transpose();
+  }
+  dense += 8.0 * Eigen::MatrixXd::Identity(3 * n, 3 * n);
+  BlockMatrix A;
+  A.rows = n;
+  A.rowStart.push_back(0);
+  for (int i = 0; i < n; ++i) {
+    A.col.push_back(i);
+    A.block.push_back(dense.block<3, 3>(3 * i, 3 * i));
+    for (int j : {i - 1, i + 1})
+      if (j >= 0 && j < n) {
+        A.col.push_back(j);
+        A.block.push_back(dense.block<3, 3>(3 * i, 3 * j));
+      }
+    A.rowStart.push_back(int(A.col.size()));
+  }
+  std::vector<Vec3d> b(n), x(n, Vec3d::Zero());
+  for (auto& v : b) v = Vec3d(u(rng), u(rng), u(rng));
+  std::vector<uint8_t> constrained{0, 1, 0, 0, 1, 0};
+  x[1] = Vec3d(0.3, -0.2, 0.1);
+  x[4] = Vec3d(-1.0, 0.5, 2.0);
+  const std::vector<Vec3d> z = x;
+  CgScratch scratch;
+  const CgResult res = filteredPcg(A, b, constrained, x, CgOptions{1e-10, 200}, scratch);
+  EXPECT_TRUE(res.converged);
+  EXPECT_LE(res.residual, 1e-10);
+  EXPECT_EQ(x[1], z[1]);
+  EXPECT_EQ(x[4], z[4]);
+  // reference: the free rows of A x = b with the constrained x fixed, solved densely
+  const std::vector<int> freeRows{0, 2, 3, 5};
+  Eigen::MatrixXd Aff(12, 12);
+  Eigen::VectorXd rhs(12);
+  Eigen::VectorXd xc = Eigen::VectorXd::Zero(3 * n);
+  for (int i : {1, 4}) xc.segment<3>(3 * i) = z[i];
+  const Eigen::VectorXd Axc = dense * xc;
+  for (int a = 0; a < 4; ++a) {
+    rhs.segment<3>(3 * a) = b[freeRows[a]] - Axc.segment<3>(3 * freeRows[a]);
+    for (int c = 0; c < 4; ++c) Aff.block<3, 3>(3 * a, 3 * c) = dense.block<3, 3>(3 * freeRows[a], 3 * freeRows[c]);
+  }
+  const Eigen::VectorXd ref = Aff.ldlt().solve(rhs);
+  for (int a = 0; a < 4; ++a) EXPECT_LT((x[freeRows[a]] - ref.segment<3>(3 * a)).norm(), 1e-8);
+}
+
+TEST(GarmentImplicit, NonConvergingCgIsReported) {
+  // the first step from rest is trivial (gravity only, across flat springs): swing for a while first
+  const float h = 1.0f / 60.0f;
+  Rig r;
+  makeHangingRig(r, 12, 0.5f, 1.0f, {0, 11});
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(stepRig(r, k * h, h).converged);
+  Rig ok = r;
+  r.params.cgMaxIterations = 1;
+  const ImplicitStats s = stepRig(r, 10 * h, h);
+  EXPECT_FALSE(s.converged);
+  EXPECT_FALSE(s.breakdown);
+  EXPECT_EQ(s.cgIterations, 1);
+  EXPECT_GT(s.cgResidual, r.params.cgTolerance);
+  EXPECT_EQ(s.constrainedVertices, 2);
+
+  const ImplicitStats s2 = stepRig(ok, 10 * h, h);
+  EXPECT_TRUE(s2.converged);
+  EXPECT_GT(s2.cgIterations, 1);
+  EXPECT_LE(s2.cgResidual, ok.params.cgTolerance);
+}
+
+// the forces of the implicit solver, integrated with symplectic explicit Euler
+void explicitEulerStep(const Model& model, const GarmentPiece& g, const SpringLaws& laws, Particles& p, float h) {
+  std::vector<Vec3d> f(g.count);
+  for (int v = 0; v < g.count; ++v) f[v] = p.mass[v] * model.solver.gravity.cast<double>();
+  for (int s = 0; s < g.springs.size(); ++s) {
+    Vec3d fi;
+    const auto& id = g.springs.ids[s];
+    springForce(g.springs, laws, s, p.x[id[0]], p.x[id[1]], fi, nullptr);
+    f[id[0]] += fi;
+    f[id[1]] -= fi;
+  }
+  for (int v = 0; v < g.count; ++v) {
+    if (model.clothPinned[v]) continue;
+    p.v[v] += (h / p.mass[v]) * f[v].cast<float>();
+    p.x[v] += h * p.v[v];
+  }
+}
+
+TEST(GarmentImplicit, StableWithDecayingEnergyWhereExplicitEulerDiverges) {
+  const float h = 1.0f / 60.0f;
+  Rig r;
+  makeHangingRig(r, 10, 0.5f, 1.0f, {0, 9});
+  const double e0 = garmentEnergy(r.model, r.g, r.params, r.p);
+  double prev = e0, lowest = e0;
+  bool converged = true;
+  for (int k = 0; k < 240; ++k) {
+    const ImplicitStats s = stepRig(r, k * h, h);
+    converged = converged && s.converged;
+    const double e = garmentEnergy(r.model, r.g, r.params, r.p);
+    // backward Euler with damping never gains energy (up to rounding of the float positions)
+    ASSERT_LE(e, prev + 1e-6 * std::abs(e0) + 1e-7) << "step " << k;
+    prev = e;
+    lowest = std::min(lowest, e);
+    for (int i = 0; i < r.model.numCloth; ++i) {
+      ASSERT_TRUE(r.p.x[i].allFinite());
+      ASSERT_LT((r.p.x[i] - Vec3(0, 1.0f, -0.25f)).norm(), 0.9f) << "bounded, step " << k;
+    }
+  }
+  EXPECT_TRUE(converged);
+  EXPECT_LT(prev, e0 - 0.01);  // it fell and lost energy
+  double kinetic = 0.0;
+  for (int i = 0; i < r.model.numCloth; ++i) kinetic += 0.5 * r.p.mass[i] * r.p.v[i].squaredNorm();
+  EXPECT_LT(kinetic, 0.02 * (e0 - prev)) << "after 4 s the swing has died down";
+  float lowestY = 10.0f;
+  for (const Vec3& x : r.p.x) lowestY = std::min(lowestY, x.y());
+  EXPECT_LT(lowestY, 0.7f) << "the sheet hangs down from its pins";
+
+  Rig e;
+  makeHangingRig(e, 10, 0.5f, 1.0f, {0, 9});
+  bool diverged = false;
+  for (int k = 0; k < 120 && !diverged; ++k) {
+    explicitEulerStep(e.model, e.g, e.params.laws, e.p, h);
+    for (const Vec3& v : e.p.v) diverged = diverged || !v.allFinite() || v.norm() > 1e3f;
+  }
+  EXPECT_TRUE(diverged) << "explicit Euler at dt = 1/60 s should blow up on these springs";
+}
+
+TEST(GarmentImplicit, PinnedVerticesNeverMove) {
+  const float h = 1.0f / 60.0f;
+  Rig r;
+  r.params.cgMaxIterations = 3;  // even an unconverged solve leaves pins alone
+  makeHangingRig(r, 8, 0.4f, 1.0f, {0, 3, 7});
+  const std::vector<Vec3> rest = r.p.x;
+  for (int k = 0; k < 60; ++k) {
+    // a disturbance aimed at a pinned vertex is ignored; one at a free vertex is reached
+    const std::vector<PositionConstraint> c{{3, Vec3(0, 2, 0)}, {20, r.p.x[20] + Vec3(0, 0.01f, 0)}};
+    const Vec3 target = c[1].target;
+    const ImplicitStats s = stepRig(r, k * h, h, c);
+    EXPECT_EQ(s.constrainedVertices, 4);
+    for (int v : {0, 3, 7}) {
+      ASSERT_EQ(std::memcmp(&r.p.x[v], &rest[v], sizeof(Vec3)), 0) << "vertex " << v << " step " << k;
+      ASSERT_EQ(r.p.v[v], Vec3::Zero());
+    }
+    EXPECT_LT((r.p.x[20] - target).norm(), 1e-5f);
+  }
+}
+
+TEST(GarmentImplicit, RefusesNegativeRayleighAlphaAndBadLaws) {
+  GarmentParams p;
+  EXPECT_NO_THROW(checkGarmentParams(p, "cloth[0].garment"));
+  p.rayleighAlpha = -9.0f;
+  try {
+    checkGarmentParams(p, "cloth[0].garment");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cloth[0].garment.rayleighAlpha"), std::string::npos) << e.what();
+  }
+  p = GarmentParams{};
+  p.laws.stretch.a2 = -1.0f;
+  EXPECT_THROW(checkGarmentParams(p, "g"), Error);
+  p = GarmentParams{};
+  p.friction.tau2 = p.friction.tau1;
+  EXPECT_THROW(checkGarmentParams(p, "g"), Error);
+}
+
+// a sheet lying on a plane tilted by 20 degrees (tan = 0.364) against a collider of friction 1:
+// dry (fabric 0.1, mixed sqrt(0.1) = 0.32) it slides; wet, on the plateau (0.5, mixed 0.71) it holds
+TEST(GarmentImplicit, WetFrictionHoldsClothThatSlidesWhenDry) {
+  auto slide = [](bool wet) {
+    Rig r;
+    r.params.friction = WetFrictionParams{0.1f, 0.8f, 0.5f, 1.0f, 2.0f, 1.0f};
+    const Quat tilt(Eigen::AngleAxisf(20.0f * kPi / 180.0f, Vec3::UnitZ()));
+    Collider plane;
+    plane.shape = ColliderShape::Plane;
+    plane.friction = 1.0f;
+    plane.keys = {Keyframe{0.0f, Vec3::Zero(), tilt}};
+    r.model.colliders.push_back(plane);
+    const Vec3 n = tilt * Vec3::UnitY(), downhill = tilt * Vec3(-1, 0, 0);
+    const TriangleMesh mesh = makeRectangle(0.006f * n, tilt * Vec3::UnitX(), Vec3::UnitZ(), 0.3f, 0.3f, 8, 8);
+    addClothPiece(r.model, "sheet", mesh, ClothMaterial{}, {}, "<test>");
+    for (int i = 0; i < r.model.numCloth; ++i)
+      r.p.add(1, uint32_t(i), r.model.clothDryMass[i], 0.04f, r.model.clothRestPosition[i], Vec3::Zero());
+    r.g = buildGarmentPiece(r.model, 0, r.params);
+    const std::vector<float> wetStart(r.model.numCloth, wet ? -100.0f : kNeverWet);
+    const float h = 1.0f / 60.0f;
+    int contacts = 0;
+    for (int k = 0; k < 60; ++k) contacts = stepRig(r, k * h, h, {}, wetStart).contacts;
+    EXPECT_GT(contacts, r.model.numCloth / 2);
+    Vec3 c = Vec3::Zero();
+    for (int i = 0; i < r.model.numCloth; ++i) {
+      c += r.p.x[i] - r.model.clothRestPosition[i];
+      EXPECT_GE(n.dot(r.p.x[i]), 0.005f - 1e-4f) << "vertex " << i << " is outside the plane";
+    }
+    return (c / float(r.model.numCloth)).dot(downhill);
+  };
+  const float dry = slide(false), wet = slide(true);
+  // sliding from rest for about 1 s at g (sin 20 - 0.32 cos 20) = 0.44 m/s^2 covers about 0.22 m
+  EXPECT_GT(dry, 0.15f);
+  EXPECT_LT(dry, 0.3f);
+  EXPECT_LT(std::abs(wet), 1e-3f);
+}
+
+// section 3.5 as a behaviour: a flat sheet squeezed to 85% between two pinned edges, without
+// gravity, is a perfect structure and stays flat; the disturbances are its imperfections, and it
+// buckles out of plane, releasing most of its compression energy
+TEST(GarmentImplicit, DisturbancesBuckleASqueezedSheetThatOtherwiseStaysFlat) {
+  auto run = [](bool disturb, double* energy) {
+    Rig r;
+    r.model.solver.gravity = Vec3::Zero();
+    r.params.wrinkles.enabled = disturb;
+    r.params.wrinkles.patchSize = 36;
+    const int res = 12;
+    std::vector<int> pins;
+    for (int j = 0; j < res; ++j) pins.insert(pins.end(), {j * res, j * res + res - 1});
+    makeHangingRig(r, res, 0.55f, 1.0f, pins);
+    for (Vec3& x : r.p.x) x.x() *= 0.85f;
+    const double flat = elasticEnergy(r.g.springs, r.params.laws, r.p.x.data());
+    const float h = 1.0f / 60.0f;
+    for (int k = 0; k < 120; ++k) {
+      const auto c = k < 60 ? computeDisturbances(r.model, 0, r.g.springs, r.g.subdomains, r.p, r.poses,
+                                                  r.params.wrinkles, uint64_t(k))
+                            : std::vector<PositionConstraint>{};
+      EXPECT_TRUE(stepRig(r, k * h, h, c).converged);
+    }
+    float out = 0.0f;
+    for (const Vec3& x : r.p.x) out = std::max(out, std::abs(x.y() - 1.0f));
+    *energy = elasticEnergy(r.g.springs, r.params.laws, r.p.x.data()) / flat;
+    return out;
+  };
+  double flatRatio = 0.0, buckledRatio = 0.0;
+  EXPECT_LT(run(false, &flatRatio), 1e-6f);
+  EXPECT_GT(run(true, &buckledRatio), 0.05f);
+  EXPECT_GT(flatRatio, 0.5);
+  EXPECT_LT(buckledRatio, 0.1);
+}
+
+// Eq. 15-19 through the whole stage: the saturated sheet (high absorption: 3.49 times its dry mass)
+// stretches more under its weight and hangs lower than the dry one
+TEST(GarmentImplicit, SaturatedClothHangsLowerThanDry) {
+  auto lowest = [](bool wet) {
+    Rig r;
+    r.params.saturation = saturationPreset("high_absorption");
+    makeHangingRig(r, 10, 0.5f, 1.0f, {0, 9});
+    const std::vector<float> wetStart(r.model.numCloth, wet ? -100.0f : kNeverWet);
+    const float h = 1.0f / 60.0f;
+    for (int k = 0; k < 180; ++k) {
+      r.poses.clear();
+      const ImplicitStats s = garmentSubstep(r.model, r.g, r.params, wetStart, k * h, h, uint64_t(k), r.poses, r.p,
+                                             r.scratch);
+      EXPECT_TRUE(s.converged);
+      r.p.x = r.p.xPred;
+    }
+    EXPECT_NEAR(r.p.mass[5], r.model.clothDryMass[5] * (wet ? 1.0 + 2.492 : 1.0), 1e-3 * r.p.mass[5]);
+    EXPECT_EQ(r.p.invMass[0], 0.0f);
+    float y = 10.0f;
+    for (const Vec3& x : r.p.x) y = std::min(y, x.y());
+    return y;
+  };
+  const float dry = lowest(false), wet = lowest(true);
+  EXPECT_LT(wet, dry - 0.008f);  // measured: 1.6 cm lower
+}
+
+TEST(GarmentImplicit, SameResultForAnyThreadCount) {
+  auto run = [](int threads) {
+    const int before = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    // 130 x 130 vertices: above the row counts where the spring, assembly and CG loops fork
+    Rig r;
+    makeHangingRig(r, 130, 1.0f, 1.0f, {0, 129});
+    const float h = 1.0f / 60.0f;
+    for (int k = 0; k < 3; ++k) stepRig(r, k * h, h);
+    omp_set_num_threads(before);
+    return r.p;
+  };
+  const Particles a = run(1), b = run(2);
+  ASSERT_EQ(a.x.size(), 16900u);
+  EXPECT_EQ(std::memcmp(a.x.data(), b.x.data(), a.x.size() * sizeof(Vec3)), 0);
+  EXPECT_EQ(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(Vec3)), 0);
+}
+
+}  // namespace
+}  // namespace soak
