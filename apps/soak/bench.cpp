@@ -170,6 +170,7 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   stage("coupling", &StageTimes::coupling);
   stage("colliders", &StageTimes::colliders);
   stage("velocities", &StageTimes::velocities);
+  stage("wetting", &StageTimes::wetting);
   stage("total", &StageTimes::total);
   double meanTotal = 0.0;
   uint64_t contacts = 0;

@@ -11,6 +11,7 @@
 #include "io/stats.hpp"
 #include "progress.hpp"
 #include "scene/overrides.hpp"
+#include "wetting/wetting.hpp"
 #include "world/emitters.hpp"
 
 #include <fmt/format.h>
@@ -89,6 +90,8 @@ void writeResolvedScene(const RunOptions& o, const std::string& path) {
 
 nlohmann::ordered_json waterJson(const WaterMass& w, const State& s) {
   return {{"freeKg", w.free},
+          {"heldInClothKg", w.heldInCloth},
+          {"inBuffersKg", w.inBuffers},
           {"emittedKg", w.emitted},
           {"removedAtBoundsKg", w.removedAtBounds},
           {"particlesRemovedAtBounds", s.ledger.particlesRemovedAtBounds},
@@ -193,7 +196,11 @@ int runCommand(const RunOptions& o) {
       }
       const std::string bad = checkState(model, state);
       // a diverged frame is written too: it shows where the blow-up started
-      writeFrameFiles(dir.string(), model, state, out, frame);
+      // the cloth's saturation (Eq. 10) as a PLY attribute and as the paper's colours in the OBJ
+      const std::vector<Vec3> colors = saturationColors(model, state, out.colorRamp);
+      std::vector<PlyFloatAttribute> extras;
+      if (model.wetting.enabled) extras.push_back({"saturation", state.clothSaturation});
+      writeFrameFiles(dir.string(), model, state, out, frame, extras, colors);
       nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
       if (!bad.empty()) line["error"] = bad;
       stats.write(line);
@@ -228,9 +235,9 @@ int runCommand(const RunOptions& o) {
                 static_cast<unsigned long long>(state.stepCount), static_cast<double>(dt),
                 Progress::formatDuration(simSeconds).c_str(),
                 state.stepCount > 0 ? 1e3 * simSeconds / static_cast<double>(state.stepCount) : 0.0, threadCount());
-    std::printf("soak: water: emitted %.6g kg = free %.6g kg + removed at bounds %.6g kg (%llu particles); "
-                "unaccounted %.3g kg\n",
-                w.emitted, w.free, w.removedAtBounds,
+    std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
+                "removed at bounds %.6g kg (%llu particles); unaccounted %.3g kg\n",
+                w.emitted, w.free, w.heldInCloth, w.inBuffers, w.removedAtBounds,
                 static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.emitted - w.total);
   }
   return kExitOk;

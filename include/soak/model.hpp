@@ -5,6 +5,7 @@
 #include <soak/params.hpp>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,10 @@ struct Keyframe {
   Quat rotation{1, 0, 0, 0};
 };
 
-enum class ColliderShape { Plane, Box, Container, Sphere, Capsule };
+enum class ColliderShape { Plane, Box, Container, Sphere, Capsule, Mesh };
+
+// signed distance grid of a closed triangle mesh (src/world/mesh_sdf.hpp); immutable once built
+struct SdfGrid;
 
 struct Collider {
   std::string name;
@@ -33,12 +37,15 @@ struct Collider {
   float radius = 0.5f;                 // m
   float halfHeight = 0.5f;             // m
   float wallThickness = 0.04f;         // m, container walls (open top)
+  // mesh: the signed distance grid of a closed OBJ in the local frame, shared by copies of the
+  // collider (read-only, so sharing is safe and a Model copy stays cheap)
+  std::shared_ptr<const SdfGrid> sdf;
   float friction = 0.3f;               // 0..1: fraction of the tangential slip removed on contact
   float restitution = 0.0f;            // 0..1: normal velocity kept, reversed, on contact
   std::vector<Keyframe> keys;          // at least one; linear translation, slerp rotation, clamped ends
 };
 
-enum class EmitterKind { Block, Jet };
+enum class EmitterKind { Block, Jet, Rain };
 
 struct Emitter {
   std::string name;
@@ -53,6 +60,12 @@ struct Emitter {
   float radius = 0.05f;      // m
   float start = 0.0f;        // s
   float end = 1.0e30f;       // s
+  // rain: drops at height origin.y over the rectangle origin +- (halfExtents.x, halfExtents.z),
+  // `rate` drops per second per m^2, falling along `direction` at dropSpeed, inside [start, end)
+  Vec3 halfExtents{0.5f, 0.0f, 0.5f};  // m (y unused)
+  float rate = 200.0f;                 // drops / (s m^2)
+  float dropSpeed = 6.5f;              // m/s, terminal speed of a 2 mm drop (Gunn & Kinzer 1949)
+  float dropRadius = 0.0f;             // m; 0: a drop is one water particle (water.particleMass)
 };
 
 // a cloth piece occupies particles [firstParticle, firstParticle + particleCount) and triangles
@@ -92,6 +105,7 @@ struct Tethers {
 struct Model {
   SolverParams solver;
   WaterParams water;
+  WettingParams wetting;
 
   std::vector<ClothPiece> pieces;
   int numCloth = 0;                              // cloth particles are [0, numCloth)

@@ -42,4 +42,41 @@ struct ClothMaterial {
   bool selfCollision = true;
 };
 
+// cloth wetting of Shao et al. 2017 section 4 (docs/models.md, "Wetting"). Saturations are
+// dimensionless (Table 1's "L"); the per-step rates refer to a step of rateStep seconds and are
+// converted to the substep actually taken, so a scene wets the same with any substep count.
+struct WettingParams {
+  bool enabled = false;              // the scene turns it on when a "wetting" section is present
+  float c = 1.0e-3f;                 // m^3/kg, c of Eq. 10: 1/rho_water, so S is the water volume fraction of V_i
+  float saturationSticky = 0.12f;    // S^T: sticking peaks here (Eq. 20), coupling softens above it (Eq. 22)
+  float saturationEmit = 0.35f;      // S^EW: water above it goes to the emission buffer (section 4.4)
+  float saturationMax = 0.4f;        // S^MAX: absorption stops here (Eq. 11)
+  float initialSaturation = 0.0f;    // S of every cloth particle at load (Fig. 6 starts saturated)
+  float rateStep = 0.015f;           // s, the step the rates kappa^a, kappa^s and the Eq. 18 transfer refer to
+  // absorption, Eq. 11
+  bool absorption = true;
+  float absorptionRate = 0.1f;       // kappa^a per rateStep
+  float absorptionGravity = 0.6f;    // eta^a
+  float minMassFraction = 0.1f;      // a water particle lighter than this times water.particleMass is absorbed whole
+  // diffusion, Eq. 12-17
+  bool diffusion = true;
+  bool diffusionGravity = true;      // the (1 + eta^d cos theta) factor (Fig. 5c); off gives Fig. 5b
+  float diffusionRate = 0.5f;        // kappa^d
+  float diffusionGravityFactor = 0.4f;  // eta^d
+  float smoothing = 0.8f;            // kappa^s per rateStep
+  float epsilon = 1.0e11f;           // (m^2 kg)^-2, epsilon of Eq. 15 (in the units of |grad C|^2)
+  int diffusionIterations = 1;       // projections per substep
+  // emission, Eq. 18-19
+  bool emission = true;
+  float beta = 1.5f;                 // s^2/m, beta of Eq. 18
+  float massThreshold = 0.002f;      // kg, m^threshold: a buffer this full forms a drip
+  float attraction = 10.0f;          // m/s^2, kappa^e of Eq. 19
+  float attractionSaturation = 0.01f;  // kg, eta^e of Eq. 19
+  // wet dynamics, Eq. 20 and Eq. 22
+  bool sticking = true;
+  float stickingRate = 0.3f;         // N, kappa^ad of Eq. 20
+  float stickingStrength = 0.02f;    // N, eta^ad of Eq. 20
+  bool permeability = true;          // Eq. 22: wetter triangles let water through
+};
+
 }  // namespace soak

@@ -14,6 +14,7 @@ struct OutputSettings {
   bool clothObj = true;      // cloth_NNNN.obj
   bool clothPly = true;      // cloth_NNNN.ply (per-vertex attributes)
   bool water = true;         // water_NNNN.ply (binary particles)
+  std::string colorRamp = "red";  // cloth OBJ vertex colours by saturation: "red" (Fig. 3), "green" (Fig. 4), "none"
 };
 
 struct Scene {

@@ -28,13 +28,18 @@ struct Particles {
 
 // where the water is: the sum of these stays constant (free + held + buffers + removed - emitted)
 struct WaterLedger {
-  double emitted = 0.0;            // kg, created by emitters
+  double emitted = 0.0;            // kg, created by emitters (and held by the cloth at load, Fig. 6)
   double removedAtBounds = 0.0;    // kg, water particles that left the domain
   uint64_t particlesRemovedAtBounds = 0;
+  double heldInCloth = 0.0;        // kg, water held by the cloth (Eq. 10's m^water), after the last wetting stage
+  double inBuffers = 0.0;          // kg, excess water in the emission buffers (section 4.4)
+  uint64_t particlesAbsorbed = 0;  // water particles absorbed whole (Eq. 11)
+  uint64_t dripsEmitted = 0;       // drip particles created from the buffers (section 4.4)
 };
 
 struct EmitterState {
   double emittedLength = 0.0;      // m of jet emitted so far (a new disc every spacing)
+  uint64_t dropsEmitted = 0;       // rain: drops created so far (drop k's place hashes k)
   bool done = false;
 };
 
@@ -45,6 +50,13 @@ struct State {
   Particles particles;
   WaterLedger ledger;
   std::vector<EmitterState> emitters;
+  // cloth wetting (Shao 2017 section 4): one entry per cloth particle when model.wetting.enabled.
+  // double for the water stores so the ledger closes to 1e-5 over long runs
+  std::vector<double> clothWater;      // kg held, m^water of Eq. 10
+  std::vector<double> clothBuffer;     // kg of excess water waiting to drip, EW^buffer of section 4.4
+  std::vector<float> clothSaturation;  // S_i of Eq. 10 at the last wetting stage
+  std::vector<uint32_t> dripId;        // ids of the drips hanging from the cloth (Eq. 19), ascending
+  std::vector<int32_t> dripSource;     // the cloth particle each drip hangs from
 };
 
 }  // namespace soak

@@ -6,10 +6,11 @@ namespace soak {
 
 struct StageTimes {         // ms of wall time per stage
   double emit = 0, predict = 0, neighbors = 0, water = 0, cloth = 0, coupling = 0, colliders = 0,
-         velocities = 0, total = 0;
+         velocities = 0, wetting = 0, total = 0;
   StageTimes& operator+=(const StageTimes& o) {
     emit += o.emit; predict += o.predict; neighbors += o.neighbors; water += o.water; cloth += o.cloth;
-    coupling += o.coupling; colliders += o.colliders; velocities += o.velocities; total += o.total;
+    coupling += o.coupling; colliders += o.colliders; velocities += o.velocities; wetting += o.wetting;
+    total += o.total;
     return *this;
   }
 };

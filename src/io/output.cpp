@@ -9,7 +9,8 @@ namespace soak {
 
 std::vector<std::string> writeFrameFiles(const std::string& dir, const Model& model, const State& state,
                                          const OutputSettings& settings, int frame,
-                                         std::span<const PlyFloatAttribute> clothExtras) {
+                                         std::span<const PlyFloatAttribute> clothExtras,
+                                         std::span<const Vec3> clothColors) {
   namespace fs = std::filesystem;
   std::vector<std::string> written;
   const bool cloth = model.numCloth > 0 && (settings.clothObj || settings.clothPly);
@@ -17,7 +18,7 @@ std::vector<std::string> writeFrameFiles(const std::string& dir, const Model& mo
   const std::vector<Vec3> normals = cloth ? clothVertexNormals(model, state.particles.x) : std::vector<Vec3>{};
   if (model.numCloth > 0 && settings.clothObj) {
     const std::string path = (fs::path(dir) / frameFileName("cloth", frame, "obj")).string();
-    writeClothObj(path, model, state, normals);
+    writeClothObj(path, model, state, normals, clothColors);
     written.push_back(path);
   }
   if (model.numCloth > 0 && settings.clothPly) {

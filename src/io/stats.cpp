@@ -23,9 +23,11 @@ WaterMass waterMass(const State& state) {
   const Particles& p = state.particles;
   for (size_t i = 0; i < p.size(); ++i)
     if (isWater(p.phase[i])) w.free += p.mass[i];
+  for (double m : state.clothWater) w.heldInCloth += m;
+  for (double m : state.clothBuffer) w.inBuffers += m;
   w.emitted = state.ledger.emitted;
   w.removedAtBounds = state.ledger.removedAtBounds;
-  w.total = w.free + w.removedAtBounds;
+  w.total = w.free + w.heldInCloth + w.inBuffers + w.removedAtBounds;
   return w;
 }
 
@@ -38,7 +40,8 @@ float stateMaxSpeed(const State& state) {
 static nlohmann::ordered_json stageJson(const StageTimes& t) {
   return {{"emit", t.emit},         {"predict", t.predict},     {"neighbors", t.neighbors},
           {"water", t.water},       {"cloth", t.cloth},         {"coupling", t.coupling},
-          {"colliders", t.colliders}, {"velocities", t.velocities}, {"total", t.total}};
+          {"colliders", t.colliders}, {"velocities", t.velocities}, {"wetting", t.wetting},
+          {"total", t.total}};
 }
 
 nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, int frame, const FrameStats& fs) {
@@ -53,8 +56,12 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
   j["steps"] = fs.steps;
   j["substeps"] = fs.substeps;
   j["counts"] = {{"water", water}, {"cloth", model.numCloth}};
-  j["waterMass"] = {{"free", w.free}, {"emitted", w.emitted}, {"removedAtBounds", w.removedAtBounds},
-                    {"total", w.total}};
+  j["waterMass"] = {{"free", w.free},       {"heldInCloth", w.heldInCloth},         {"inBuffers", w.inBuffers},
+                    {"emitted", w.emitted}, {"removedAtBounds", w.removedAtBounds}, {"total", w.total}};
+  if (model.wetting.enabled)
+    j["wetting"] = {{"particlesAbsorbed", state.ledger.particlesAbsorbed},
+                    {"dripsEmitted", state.ledger.dripsEmitted},
+                    {"dripsHanging", state.dripId.size()}};
   j["removedAtBounds"] = {{"frame", fs.removedParticles}, {"total", state.ledger.particlesRemovedAtBounds}};
   j["emittedParticles"] = fs.emittedParticles;
   j["couplingContacts"] = fs.couplingContacts;

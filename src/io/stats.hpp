@@ -26,18 +26,19 @@ struct FrameStats {
   void add(const StepStats& s);
 };
 
-// where the water is (kg): free particles, emitted so far, removed at the domain bounds; total is
-// free + removedAtBounds and equals emitted while water is conserved
+// where the water is (kg): free particles, held by the cloth, in the cloth's emission buffers
+// (Shao 2017 section 4), emitted so far, removed at the domain bounds; total is
+// free + heldInCloth + inBuffers + removedAtBounds and equals emitted while water is conserved
 struct WaterMass {
-  double free = 0.0, emitted = 0.0, removedAtBounds = 0.0, total = 0.0;
+  double free = 0.0, heldInCloth = 0.0, inBuffers = 0.0, emitted = 0.0, removedAtBounds = 0.0, total = 0.0;
 };
 WaterMass waterMass(const State& state);
 
 // the largest particle speed in the state (m/s), used for frame 0 where no step ran
 float stateMaxSpeed(const State& state);
 
-// the stats line of one frame: frame, time, step, steps, substeps, counts, waterMass,
-// removedAtBounds, couplingContacts, meanDensityRatio, maxSpeed, ms (per stage, summed), msPerStep
+// the stats line of one frame: frame, time, step, steps, substeps, counts, waterMass, wetting (when
+// on), removedAtBounds, couplingContacts, meanDensityRatio, maxSpeed, ms (per stage, summed), msPerStep
 nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, int frame, const FrameStats& fs);
 
 // appends JSON lines to a file, flushing after each line so a crashed run keeps its stats

@@ -107,6 +107,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb
           const Vec3& n0 = s.startNormal[tri];
           const Vec3& n1 = s.normal[tri];
           if (n0.isZero() || n1.isZero()) continue;
+          if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
           // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
           const float side = (xq0 - p.x[f[0]]).dot(n0) >= 0.0f ? 1.0f : -1.0f;
           const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;

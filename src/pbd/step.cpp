@@ -37,6 +37,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   ms.neighbors += clock.lap();
   updateColliderPoses(model, state.time + h, ws.poses);
   computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
+  scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
   solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
   ms.water += clock.lap();
   solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // stretch Eq. 8, bend Eq. 9
@@ -45,6 +46,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   ms.cloth += clock.lap();
   projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction
   ms.colliders += clock.lap();
+  updateCouplingStiffness(model, state, ws.coupling.triangleStiffness);             // Eq. 22: wetter cloth lets water through
   for (int it = 0; it < model.solver.couplingIterations; ++it)                     // water-cloth, Eq. 21-22
     stats.couplingContacts += solveCoupling(model, p, ws.neighbors, ws.coupling, false);
   solveCoupling(model, p, ws.neighbors, ws.coupling, true);                         // no water crosses the cloth
@@ -54,6 +56,15 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   fluidVelocityPass(model, p, ws.neighbors, ws.fluid, h);                           // XSPH, vorticity
   stats.meanDensityRatio = meanDensityRatio(model, p, ws.fluid);
   commitPositions(p);                                                               // x = x*
+  ms.velocities += clock.lap();
+  updatePorosity(model, state, ws.neighbors, ws.wetting);                           // V_i, S_i, wet mass (Eq. 10)
+  absorbWater(model, state, ws.neighbors, ws.wetting, h);                           // water soaks in (Eq. 11)
+  diffuseWater(model, state, ws.neighbors, ws.wetting, h);                          // spreads in the cloth (Eq. 12-17)
+  emitExcessWater(model, state, ws.neighbors, ws.grid, ws.wetting, h);              // excess runs down, drips (Eq. 18)
+  applyDripAttraction(model, state, ws.neighbors, ws.wetting, h);                   // cloth holds its drips (Eq. 19)
+  applySticking(model, state, ws.neighbors, ws.wetting, h);                         // wet cloth sticks (Eq. 20)
+  finishWetting(model, state, ws.wetting);                                          // absorbed water leaves; ledger
+  ms.wetting += clock.lap();
   stats.removedParticles += removeOutsideDomain(model, state, ws.keep);             // counted in the ledger
   ms.velocities += clock.lap();
   state.time += h;

@@ -6,6 +6,7 @@
 #include "pbd/cloth.hpp"
 #include "pbd/coupling.hpp"
 #include "pbd/fluid.hpp"
+#include "wetting/wetting.hpp"
 #include "world/colliders.hpp"
 
 #include <vector>
@@ -21,6 +22,7 @@ struct Workspace {
   ClothScratch cloth;
   CouplingScratch coupling;
   std::vector<uint8_t> keep;            // particles kept after the domain check
+  WettingScratch wetting;               // cloth wetting (Shao 2017 section 4)
 };
 
 }  // namespace soak

@@ -15,6 +15,7 @@
 #include "pbd/tethers.hpp"
 #include "scene/overrides.hpp"
 #include "scene/reader.hpp"
+#include "wetting/wetting.hpp"
 
 namespace soak {
 
@@ -99,7 +100,86 @@ void readOutput(ObjectReader r, OutputSettings& o) {
   o.clothObj = r.boolean("clothObj", d.clothObj);
   o.clothPly = r.boolean("clothPly", d.clothPly);
   o.water = r.boolean("water", d.water);
+  const std::vector<std::string> ramps = {"red", "green", "none"};
+  const int ramp = r.choice("colorRamp", ramps, d.colorRamp);
+  if (ramp >= 0) o.colorRamp = ramps[size_t(ramp)];
   r.finish();
+}
+
+// "wetting" (Shao 2017 section 4): a present section is enabled unless "enabled": false
+void readWetting(ObjectReader r, WettingParams& w) {
+  const WettingParams d;
+  ErrorLog& log = r.log();
+  w.enabled = r.boolean("enabled", r.present());
+  w.c = r.number("c", d.c, Range::positive());
+  w.rateStep = r.number("rateStep", d.rateStep, Range::positive());
+  ObjectReader s = r.object("saturation");
+  const Range fraction{0.0, 1.0, true, false};  // (0, 1]
+  w.saturationSticky = s.number("sticky", d.saturationSticky, fraction);
+  w.saturationEmit = s.number("emit", d.saturationEmit, fraction);
+  w.saturationMax = s.number("max", d.saturationMax, fraction);
+  w.initialSaturation = s.number("initial", d.initialSaturation, Range::unit());
+  s.finish();
+  if (!(w.saturationSticky < w.saturationEmit))
+    log.error(s.pathOf("sticky"), fmt::format("expected a number < wetting.saturation.emit ({}), got {}",
+                                              w.saturationEmit, w.saturationSticky));
+  if (w.saturationEmit > w.saturationMax)
+    log.error(s.pathOf("emit"), fmt::format("expected a number <= wetting.saturation.max ({}), got {}",
+                                            w.saturationMax, w.saturationEmit));
+  if (w.initialSaturation > w.saturationMax)
+    log.error(s.pathOf("initial"), fmt::format("expected a number <= wetting.saturation.max ({}), got {}",
+                                               w.saturationMax, w.initialSaturation));
+  ObjectReader a = r.object("absorption");
+  w.absorption = a.boolean("enabled", d.absorption);
+  w.absorptionRate = a.number("rate", d.absorptionRate, Range::unit());
+  w.absorptionGravity = a.number("gravityInfluence", d.absorptionGravity, Range::unit());
+  w.minMassFraction = a.number("minMassFraction", d.minMassFraction, Range{0.0, 1.0, false, true});
+  a.finish();
+  ObjectReader f = r.object("diffusion");
+  w.diffusion = f.boolean("enabled", d.diffusion);
+  w.diffusionGravity = f.boolean("gravity", d.diffusionGravity);
+  w.diffusionRate = f.number("rate", d.diffusionRate, Range::nonNegative());
+  w.diffusionGravityFactor = f.number("gravityInfluence", d.diffusionGravityFactor, Range::unit());
+  w.smoothing = f.number("smoothing", d.smoothing, Range::unit());
+  w.epsilon = f.number("epsilon", d.epsilon, Range::nonNegative());
+  w.diffusionIterations = f.integer("iterations", d.diffusionIterations, Range::atLeast(1));
+  f.finish();
+  ObjectReader e = r.object("emission");
+  w.emission = e.boolean("enabled", d.emission);
+  w.beta = e.number("beta", d.beta, Range::nonNegative());
+  w.massThreshold = e.number("massThreshold", d.massThreshold, Range::positive());
+  w.attraction = e.number("attraction", d.attraction, Range::nonNegative());
+  w.attractionSaturation = e.number("attractionSaturation", d.attractionSaturation, Range::nonNegative());
+  e.finish();
+  ObjectReader k = r.object("sticking");
+  w.sticking = k.boolean("enabled", d.sticking);
+  w.stickingRate = k.number("rate", d.stickingRate, Range::nonNegative());
+  w.stickingStrength = k.number("strength", d.stickingStrength, Range::nonNegative());
+  k.finish();
+  ObjectReader m = r.object("permeability");
+  w.permeability = m.boolean("enabled", d.permeability);
+  m.finish();
+  r.finish();
+}
+
+// a drip needs m^threshold in one buffer: refuse a threshold above what a typical (median) particle of
+// some piece can hold at S^MAX (S^MAX V / c, Eq. 10)
+void checkDripThreshold(ErrorLog& log, const Model& model, const std::vector<float>& volume) {
+  const WettingParams& w = model.wetting;
+  if (!w.enabled || !w.emission) return;
+  for (size_t k = 0; k < model.pieces.size(); ++k) {
+    const ClothPiece& piece = model.pieces[k];
+    std::vector<float> v(volume.begin() + piece.firstParticle,
+                         volume.begin() + piece.firstParticle + piece.particleCount);
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    const double hold = double(w.saturationMax) * v[v.size() / 2] / w.c;
+    if (double(w.massThreshold) > hold)
+      log.error("wetting.emission.massThreshold",
+                fmt::format("expected at most the water a cloth particle of cloth[{}] ('{}') can hold, S^MAX V / c = "
+                            "{:.4g} kg (median V = {:.4g} m^3), got {} (lower it, or lower wetting.c)",
+                            k, piece.name, hold, v[v.size() / 2], w.massThreshold));
+  }
 }
 
 ClothMaterial readMaterial(ObjectReader r) {
@@ -433,6 +513,7 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   readSolver(top.object("solver"), model.solver);
   readWater(top.object("water"), model.water);
   readOutput(top.object("output"), scene.output);
+  readWetting(top.object("wetting"), model.wetting);
   const int maxVertices = model.solver.maxParticles;
   const std::vector<ClothSpec> cloth = readArray<ClothSpec>(top, "cloth", [&](const Json& v, const std::string& p, int i) {
     return readCloth(log, v, p, i, baseDir, maxVertices);
@@ -471,6 +552,12 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   }
   scene.state.nextId = uint32_t(model.numCloth);
   scene.state.emitters.resize(model.emitters.size());
+  if (model.wetting.enabled) {
+    const std::vector<float> volume = restVolumes(model, p.radius);
+    checkDripThreshold(log, model, volume);
+    log.throwIfAny();
+    initWettingState(model, volume, scene.state);
+  }
   return scene;
 }
 

@@ -3,6 +3,7 @@
 #include "world/colliders.hpp"
 
 #include "world/container.hpp"
+#include "world/mesh_sdf.hpp"
 
 #include "core/parallel.hpp"
 
@@ -79,6 +80,11 @@ float localDistance(const Collider& c, const Vec3& p, Vec3* n) {
       }
       return best;
     }
+    case ColliderShape::Mesh:
+      // trilinear grid of the closed mesh (world/mesh_sdf.hpp); a mesh without a grid is far away
+      if (c.sdf) return sampleSdf(*c.sdf, p, n);
+      *n = Vec3(0, 1, 0);
+      return 1.0e30f;
   }
   *n = Vec3(0, 1, 0);
   return p.y();

@@ -1,0 +1,166 @@
+// water absorption, section 4.2 of Shao et al. 2017 (Eq. 11): a cloth particle i soaks up to
+//   m_i^absorbed = kappa^a (1 + eta^a cos theta_ij) (S^MAX - S_i) V_i / c
+// from each neighbouring water particle j, more from water above it than below it. As NOTES.md reads
+// Eq. 11, the cloth gains exactly the mass the water loses; a shrunken particle keeps
+// h' = (m'/m0)^(1/3) h0, and one left below the minimum mass is absorbed whole. The 1/c turns Eq. 11's
+// saturation volume into kilograms (S = c m / V, Eq. 10).
+#include "wetting/wetting.hpp"
+
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+// marks the water particles hanging as drips (section 4.4): they are held by Eq. 19, not soaked up
+void markDrips(const Model& model, const State& state, std::vector<uint8_t>& isDrip) {
+  const Particles& p = state.particles;
+  isDrip.assign(p.size(), 0);
+  // ids ascend with the particle index (particles are appended with fresh ids and compacted stably)
+  const auto first = p.id.begin() + model.numCloth;
+  for (uint32_t id : state.dripId) {
+    const auto it = std::lower_bound(first, p.id.end(), id);
+    if (it != p.id.end() && *it == id) isDrip[static_cast<size_t>(it - p.id.begin())] = 1;
+  }
+}
+
+}  // namespace
+
+size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h) {
+  s.anyAbsorbedWhole = false;
+  const WettingParams& w = model.wetting;
+  Particles& p = state.particles;
+  const int64_t nc = model.numCloth;
+  const int64_t n = static_cast<int64_t>(p.size());
+  if (!w.enabled || !w.absorption || nc == 0 || n == nc) return 0;
+  const float kappa = rateForStep(w.absorptionRate, h, w.rateStep);
+  const float eta = w.absorptionGravity;
+  const Vec3 g = gravityDirection(model);
+  const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
+  const float minMass = w.minMassFraction * m0;
+
+  // what each cloth particle can still take, kg: (S^MAX - S_i) V_i / c, the buffer counting as held
+  s.capacity.resize(static_cast<size_t>(nc));
+  parallelFor(nc, [&](int64_t i) {
+    const double room = static_cast<double>(w.saturationMax) * s.volume[i] / w.c - state.clothWater[i] -
+                        state.clothBuffer[i];
+    s.capacity[i] = static_cast<float>(std::max(0.0, room));
+  });
+  markDrips(model, state, s.isDrip);
+  // Eq. 11: the most cloth particle i may take from water particle j
+  const auto request = [&](int64_t i, int64_t j) {
+    return kappa * (1.0f + eta * cosGravity(p.x[i], p.x[j], g)) * s.capacity[i];
+  };
+  const auto absorbs = [&](int64_t j) { return isWater(p.phase[j]) && !s.isDrip[j]; };
+
+  // 1. per water particle: the share of the requests its mass can meet (gather)
+  s.waterScale.assign(static_cast<size_t>(n), 0.0f);
+  parallelFor(n - nc, [&](int64_t k) {
+    const int64_t j = nc + k;
+    if (!absorbs(j)) return;
+    float total = 0.0f;
+    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+      const int64_t i = nb.index[e];
+      if (i < nc) total += request(i, j);
+    }
+    if (total > 0.0f) s.waterScale[j] = total > p.mass[j] ? p.mass[j] / total : 1.0f;
+  });
+  // 2. per cloth particle: the share of what it is offered that fits its capacity (gather)
+  s.clothScale.assign(static_cast<size_t>(nc), 0.0f);
+  parallelFor(nc, [&](int64_t i) {
+    if (s.capacity[i] <= 0.0f) return;
+    float offered = 0.0f;
+    for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+      const int64_t j = nb.index[e];
+      if (j >= nc && s.waterScale[j] > 0.0f) offered += s.waterScale[j] * request(i, j);
+    }
+    s.clothScale[i] = offered > s.capacity[i] ? s.capacity[i] / offered : 1.0f;
+  });
+  // 3. per water particle: what it loses; partial absorption shrinks it, a remnant is taken whole
+  s.waterLost.assign(static_cast<size_t>(n), 0.0);
+  s.keep.assign(static_cast<size_t>(n), 1);
+  parallelFor(n - nc, [&](int64_t k) {
+    const int64_t j = nc + k;
+    if (s.waterScale[j] <= 0.0f) return;
+    float loss = 0.0f;
+    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+      const int64_t i = nb.index[e];
+      if (i < nc) loss += s.clothScale[i] * s.waterScale[j] * request(i, j);
+    }
+    if (loss <= 0.0f) return;
+    const float before = p.mass[j];
+    const float after = before - loss;
+    if (after < minMass) {
+      s.waterLost[j] = before;  // full absorption: the particle leaves at the end of the substep
+      s.keep[j] = 0;
+      p.mass[j] = 0.0f;
+      return;
+    }
+    p.mass[j] = after;
+    p.invMass[j] = 1.0f / after;
+    p.radius[j] = std::cbrt(after / m0) * h0;  // h' = (m'/m0)^(1/3) h0, the adaptive sampling of Eq. 11
+    s.waterLost[j] = static_cast<double>(before) - static_cast<double>(after);  // exact: both are floats
+  });
+  // 4. the cloth gains in a fixed order (water ascending, neighbours in list order): each water
+  // particle's loss split over its absorbers by their share, the last taking the remainder exactly
+  size_t whole = 0;
+  for (int64_t j = nc; j < n; ++j) {
+    const double lost = s.waterLost[j];
+    if (lost <= 0.0) continue;
+    whole += s.keep[j] ? 0 : 1;
+    double shares = 0.0;
+    int64_t last = -1;
+    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+      const int64_t i = nb.index[e];
+      if (i >= nc) continue;
+      const double t = static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j);
+      if (t > 0.0) {
+        shares += t;
+        last = i;
+      }
+    }
+    if (last < 0) continue;  // unreachable: a loss needs an absorber
+    double given = 0.0;
+    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+      const int64_t i = nb.index[e];
+      if (i >= nc) continue;
+      const double t = static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j);
+      if (t <= 0.0) continue;
+      const double gain = i == last ? lost - given : lost * (t / shares);
+      given += gain;
+      state.clothWater[i] += gain;
+      // the absorbed water brings its momentum (inelastic: the cloth particle gets heavier)
+      const float mi = p.mass[i], dm = static_cast<float>(gain);
+      if (!model.clothPinned[i]) {
+        p.v[i] = (mi * p.v[i] + dm * p.v[j]) / (mi + dm);
+        p.invMass[i] = 1.0f / (mi + dm);
+      }
+      p.mass[i] = mi + dm;
+    }
+  }
+  s.anyAbsorbedWhole = whole > 0;
+  state.ledger.particlesAbsorbed += whole;
+  return whole;
+}
+
+void finishWetting(const Model& model, State& state, WettingScratch& s) {
+  if (!model.wetting.enabled) return;
+  if (s.anyAbsorbedWhole) {
+    // drips made after the absorption stage sit past the end of keep: they stay
+    s.keep.resize(state.particles.size(), 1);
+    state.particles.compact(s.keep);
+    s.anyAbsorbedWhole = false;
+  }
+  double held = 0.0, buffered = 0.0;
+  for (size_t i = 0; i < state.clothWater.size(); ++i) {
+    held += state.clothWater[i];
+    buffered += state.clothBuffer[i];
+  }
+  state.ledger.heldInCloth = held;
+  state.ledger.inBuffers = buffered;
+}
+
+}  // namespace soak

@@ -1,0 +1,91 @@
+// water diffusion inside the cloth, section 4.3 of Shao et al. 2017 (Eq. 12-17). The saturation
+// constraint of particle i,
+//   C_i(S) = sum_j (kappa_i^d + kappa_j^d)/2 (S_j - S_i)/rho0 (1 + eta^d cos theta_ij) lap W_ij  (Eq. 12),
+// is projected as in PBD: lambda_i = -C_i / (sum_k |grad_k C_i|^2 + epsilon) (Eq. 15) and
+// S_i += kappa^s lambda_i grad_i C_i (Eq. 17). Eq. 17 as printed changes only S_i, so the held water
+// drifts; soak writes the same projection as pairwise exchange (NOTES.md, docs/models.md): the water
+// entering i from j is the water leaving j towards i,
+//   dm_{j->i} = kappa^s min(sigma_i, sigma_j) w_ij (S_j - S_i) min(V_i, V_j) / c,
+// with sigma_i = a_i / (a_i^2 + sum_j w_ij^2 + epsilon) the step of Eq. 15-17 (a_i = sum_j w_ij, the
+// diagonal derivative of Eq. 16) and w_ij = (kappa_i^d + kappa_j^d)/2 (1 + eta^d cos) lap W_ij / rho0,
+// where cos is taken along the flow: water going down is sped up, water going up slowed down. sigma_i
+// uses the largest gravity factor (1 + eta^d |cos|), so no particle gives more than it holds.
+#include "wetting/wetting.hpp"
+
+#include "core/kernels.hpp"
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+void diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h) {
+  const WettingParams& w = model.wetting;
+  const int64_t nc = model.numCloth;
+  if (!w.enabled || !w.diffusion || nc == 0) return;
+  const Particles& p = state.particles;
+  const int iterations = std::max(1, w.diffusionIterations);
+  const float kappaS = rateForStep(w.smoothing, h / static_cast<float>(iterations), w.rateStep);
+  const float kd = w.diffusionRate;  // isotropic cloth: (kappa_i^d + kappa_j^d) / 2 = kappa^d
+  const float eta = w.diffusionGravity ? w.diffusionGravityFactor : 0.0f;
+  const Vec3 g = gravityDirection(model);
+  const double c = w.c;
+  std::vector<float>& sat = state.clothSaturation;
+  s.sigma.resize(static_cast<size_t>(nc));
+  s.delta.resize(static_cast<size_t>(nc));
+
+  // the pair's geometry, the same numbers seen from i or j (up to the sign of cos): the distance and
+  // w_ij / (1 + eta cos) = (kappa_i^d + kappa_j^d)/2 lap W_ij / rho0 (Eq. 12), and cos theta_ij
+  const auto pair = [&](int64_t i, int64_t j, float& cosIJ) {
+    const Vec3 d = p.x[i] - p.x[j];
+    const float r = d.norm();
+    cosIJ = r > 1e-12f ? d.dot(g) / r : 0.0f;
+    const float rho0 = model.pieces[clothPiece(p.phase[i])].material.restDensity;
+    return kd * viscosityLaplacian(r, pairRadius(p.radius[i], p.radius[j])) / rho0;
+  };
+  const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
+  // nothing held, nothing to spread (the common case before the water arrives)
+  bool any = false;
+  for (int64_t i = 0; i < nc && !any; ++i) any = state.clothWater[i] > 0.0;
+  if (!any) return;
+
+  for (int it = 0; it < iterations; ++it) {
+    computeSaturation(model, state, s, sat);
+    // sigma_i: the PBD step of i's constraint (Eq. 15-17) with the gradients of Eq. 16
+    parallelFor(nc, [&](int64_t i) {
+      float a = 0.0f, sq = 0.0f;
+      for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+        const int64_t j = nb.index[e];
+        if (!samePiece(i, j)) continue;
+        float cosIJ;
+        const float wij = pair(i, j, cosIJ) * (1.0f + eta * std::fabs(cosIJ));
+        a += wij;
+        sq += wij * wij;
+      }
+      s.sigma[i] = a > 0.0f ? a / (a * a + sq + w.epsilon) : 0.0f;
+    });
+    // pairwise exchange, gathered per particle: the flow j -> i is bit for bit minus the flow i -> j
+    parallelFor(nc, [&](int64_t i) {
+      double dm = 0.0;
+      for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+        const int64_t j = nb.index[e];
+        if (!samePiece(i, j)) continue;
+        const double diff = static_cast<double>(sat[j]) - static_cast<double>(sat[i]);
+        if (diff == 0.0) continue;
+        float cosIJ;
+        const float base = pair(i, j, cosIJ);
+        // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
+        const float cosFlow = diff > 0.0 ? cosIJ : -cosIJ;
+        const double coef = static_cast<double>(kappaS) * std::min(s.sigma[i], s.sigma[j]) *
+                            (base * (1.0f + eta * cosFlow)) * std::min(s.volume[i], s.volume[j]) / c;
+        dm += coef * diff;
+      }
+      s.delta[i] = dm;
+    });
+    parallelFor(nc, [&](int64_t i) { state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]); });
+  }
+  computeSaturation(model, state, s, sat);
+}
+
+}  // namespace soak

@@ -1,0 +1,28 @@
+// the paper's saturation colours for the cloth OBJ: dry cloth in a bright colour fading to black as it
+// saturates (red in Fig. 3, green in Fig. 4)
+#include "wetting/wetting.hpp"
+
+#include <algorithm>
+
+namespace soak {
+
+std::vector<Vec3> saturationColors(const Model& model, const State& state, const std::string& ramp) {
+  const size_t nc = static_cast<size_t>(model.numCloth);
+  if (!model.wetting.enabled || state.clothSaturation.size() != nc) return {};
+  Vec3 dry;
+  if (ramp == "red")
+    dry = Vec3(1.0f, 0.0f, 0.0f);
+  else if (ramp == "green")
+    dry = Vec3(0.0f, 1.0f, 0.0f);
+  else
+    return {};
+  const float sMax = model.wetting.saturationMax;
+  std::vector<Vec3> colors(nc);
+  for (size_t i = 0; i < nc; ++i) {
+    const float t = sMax > 0.0f ? std::clamp(state.clothSaturation[i] / sMax, 0.0f, 1.0f) : 0.0f;
+    colors[i] = (1.0f - t) * dry;
+  }
+  return colors;
+}
+
+}  // namespace soak

@@ -1,0 +1,140 @@
+// cloth wetting of Shao, Wu, Wang 2017 section 4: cloth particles are porous and hold water. One
+// model per file, each a stage of the substep (src/pbd/step.cpp), in the order of Algorithm 1:
+//   permeability.cpp  Eq. 22   coupling stiffness from saturation (before the coupling)
+//   porosity.cpp      Eq. 10   particle volume, saturation, wet mass
+//   absorption.cpp    Eq. 11   water particles soak into the cloth (gravity weighted)
+//   diffusion.cpp     Eq. 12-17 water spreads inside the cloth (PBD projection, pairwise exchange)
+//   emission.cpp      Eq. 18-19 excess water runs down, gathers and drips
+//   sticking.cpp      Eq. 20   wet cloth sticks to itself
+// Every stage returns at once when model.wetting.enabled (or its own switch) is off, keeps the water
+// ledger exact (the cloth gains what the water loses) and gives the same result for any thread count.
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+
+#include "grid/grid.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace soak {
+
+// scratch of the wetting stages, reused from substep to substep
+struct WettingScratch {
+  std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this substep
+  std::vector<float> capacity;     // kg a cloth particle can still absorb (Eq. 11)
+  std::vector<float> clothScale;   // share of its requests a cloth particle grants (Eq. 11)
+  std::vector<float> waterScale;   // share of its mass a water particle can give (Eq. 11)
+  std::vector<double> waterLost;   // kg each water particle lost to the cloth this substep
+  std::vector<uint8_t> isDrip;     // water particles hanging as drips (not absorbed)
+  std::vector<uint8_t> keep;       // 0 for water absorbed whole; compacted by finishWetting
+  bool anyAbsorbedWhole = false;
+  std::vector<float> sigma;        // PBD step of each particle's saturation constraint (Eq. 15-17)
+  std::vector<double> delta;       // kg, change of held water or buffer of this pass
+  std::vector<uint8_t> transfers;  // Eq. 18 holds for the particle
+  std::vector<float> outScale;     // keeps a buffer's outflow within the buffer (Eq. 18)
+  std::vector<int64_t> dripOf;     // index of the drip hanging from each cloth particle, -1 when none
+  std::vector<Vec3> force;         // N, sticking force per cloth particle (Eq. 20)
+};
+
+// a rate per rateStep (0..1, a fraction removed per step) converted to a step of h seconds, so that n
+// substeps of h = rateStep / n do what one step of rateStep does: 1 - (1 - kappa)^(h / rateStep)
+inline float rateForStep(float kappa, float h, float rateStep) {
+  if (kappa <= 0.0f) return 0.0f;
+  if (kappa >= 1.0f) return 1.0f;
+  return 1.0f - std::pow(1.0f - kappa, h / rateStep);
+}
+
+// unit gravity direction, zero when there is no gravity (then every gravity factor is 1)
+inline Vec3 gravityDirection(const Model& model) {
+  const float g = model.solver.gravity.norm();
+  return g > 1e-12f ? Vec3(model.solver.gravity / g) : Vec3::Zero();
+}
+
+// cos theta_ij of Shao 2017: the angle between x_i - x_j and gravity; positive when i lies below j
+inline float cosGravity(const Vec3& xi, const Vec3& xj, const Vec3& gDir) {
+  const Vec3 d = xi - xj;
+  const float len = d.norm();
+  return len > 1e-12f ? d.dot(gDir) / len : 0.0f;
+}
+
+// porosity.cpp ------------------------------------------------------------------------------------
+
+// V_i = 1 / sum_k W_ik over the cloth particles of the same piece within h of i, k including i (Eq. 10,
+// Akinci et al. 2012), at the rest shape: used at load for the initial water and the checks
+std::vector<float> restVolumes(const Model& model, const std::vector<float>& radius);
+
+// sizes the wetting state of a loaded scene and fills the cloth with model.wetting.initialSaturation
+// (counted as emitted in the ledger). volume: restVolumes of the cloth.
+void initWettingState(const Model& model, const std::vector<float>& volume, State& state);
+
+// V_i = 1 / sum_k W_ik (Eq. 10) of every cloth particle from neighbour lists built on positions x
+void clothVolumes(const Model& model, const std::vector<Vec3>& x, const std::vector<float>& radius,
+                  const std::vector<int32_t>& phase, const NeighborLists& nb, std::vector<float>& volume);
+
+// Eq. 10 at this substep's positions: V_i, S_i = c m^water_i / V_i, and the wet mass
+// m_i = dry + held + buffer (pinned particles keep inverse mass 0)
+void updatePorosity(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s);
+
+// S_i = c m / V_i for the held water of every cloth particle
+void computeSaturation(const Model& model, const State& state, const WettingScratch& s, std::vector<float>& sat);
+
+// permeability.cpp --------------------------------------------------------------------------------
+
+// Eq. 22: kappa^couple = clamp(1 - (S~a + S~b + S~c) / (3 (S^MAX - S^T)), 0, 1), S~ = max(0, S - S^T),
+// per triangle from the saturations of the last wetting stage; 1 everywhere when wetting is off
+void updateCouplingStiffness(const Model& model, const State& state, std::vector<float>& triangleStiffness);
+float couplingStiffness(const WettingParams& w, float sa, float sb, float sc);
+
+// the same factor per cloth particle, kappa^couple(S_i, S_i, S_i), applied to its Akinci boundary mass
+// Psi_i in the water's density: a soaked particle no longer holds water up (docs/models.md)
+void scaleBoundaryByPermeability(const Model& model, const State& state, std::vector<float>& psi);
+
+// absorption.cpp ----------------------------------------------------------------------------------
+
+// Eq. 11 with the corrections of NOTES.md: water particle j gives its cloth neighbours i up to
+// kappa^a (1 + eta^a cos theta_ij) (S^MAX - S_i) V_i / c each; a particle left lighter than the
+// minimum mass is absorbed whole (marked in s.keep, removed by finishWetting), else it shrinks to
+// h' = (m'/m0)^(1/3) h0. Returns the number of particles absorbed whole. Uses p.x (after the commit).
+size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
+
+// removes the water absorbed whole (stable compaction, ids kept) and brings the ledger's held and
+// buffered totals up to date; the last wetting stage of a substep
+void finishWetting(const Model& model, State& state, WettingScratch& s);
+
+// diffusion.cpp -----------------------------------------------------------------------------------
+
+// Eq. 12-17 as a PBD projection of the saturation field, written as pairwise exchange of held water
+// between neighbouring particles of the same piece so the held total is conserved (NOTES.md)
+void diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
+
+// emission.cpp ------------------------------------------------------------------------------------
+
+// section 4.4: water above S^EW moves into the buffer; buffers pass down to the neighbours below when
+// Eq. 18 holds; a buffer that reaches m^threshold forms a drip below the cloth (placed where its
+// density is not above rest), and feeds the drip hanging from it. Returns the number of drips created.
+size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
+                       WettingScratch& s, float h);
+
+// Eq. 19: the cloth around a drip pulls it (and is pulled back) until it is heavy enough to fall
+void applyDripAttraction(const Model& model, State& state, const NeighborLists& nb, const WettingScratch& s,
+                         float h);
+
+// sticking.cpp ------------------------------------------------------------------------------------
+
+// Eq. 20 coefficient of a touching pair, N: (eta^ad - kappa^ad |(S_i - S^T)(S_j - S^T)|)+, times a
+// wetness ramp min(1, S/S^T) of each particle so dry cloth does not stick; largest at S^T
+float stickingCoefficient(const WettingParams& w, float si, float sj);
+
+// Eq. 20 between touching wet cloth particles (those far apart on the rest shape), applied to the
+// velocities; equal and opposite per pair
+void applySticking(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
+
+// output.cpp --------------------------------------------------------------------------------------
+
+// vertex colours of the cloth by saturation S / S^MAX: "red" fades red to black (Fig. 3), "green" green
+// to black (Fig. 4); empty for "none" or when wetting is off
+std::vector<Vec3> saturationColors(const Model& model, const State& state, const std::string& ramp);
+
+}  // namespace soak

@@ -1,0 +1,135 @@
+// emission (section 4.4, Eq. 18-19): no drip before a buffer holds m^threshold, one drip of that mass
+// at it, placed without a density spike and held by the cloth; a saturated hanging cloth drains and
+// drips (Fig. 6)
+#include "wetting/wet_support.hpp"
+
+#include "core/kernels.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace soak;
+using namespace soak::testing;
+
+namespace {
+
+// SPH density at particle q: its own mass, the water and the cloth as Akinci boundary (rho0 V_b)
+float densityAt(const Scene& s, const WettingScratch& ws, size_t q) {
+  const Particles& p = s.state.particles;
+  float rho = p.mass[q] * poly6(0.0f, p.radius[q]);
+  for (size_t j = 0; j < p.size(); ++j) {
+    if (j == q) continue;
+    const float h = pairRadius(p.radius[q], p.radius[j]);
+    const float mj = j < size_t(s.model.numCloth) ? s.model.water.restDensity * ws.volume[j] : p.mass[j];
+    rho += mj * poly6((p.x[q] - p.x[j]).squaredNorm(), h);
+  }
+  return rho;
+}
+
+}  // namespace
+
+TEST(WettingEmission, NoDripBelowTheThresholdOneDripAtIt) {
+  // a pinned vertical sheet; its bottom row (y = 0.9) has no neighbour below to pass water to
+  Scene s = sceneFromJson(R"({"cloth": [)" +
+                          rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.2f, 11, 11, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
+                          R"(], "wetting": {}})");
+  StageRig rig;
+  rig.refresh(s.state, s.model);
+  const float thr = s.model.wetting.massThreshold;
+  const size_t bottom = 5;
+  ASSERT_NEAR(s.state.particles.x[bottom].y(), 0.9f, 1e-6f);
+  s.state.clothBuffer[bottom] = 0.99 * thr;
+  const float h = s.model.solver.dt;
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, h), 0u);
+  EXPECT_EQ(s.state.particles.size(), size_t(s.model.numCloth));
+  EXPECT_DOUBLE_EQ(s.state.clothBuffer[bottom], 0.99 * thr);
+
+  s.state.clothBuffer[bottom] = 1.25 * thr;
+  const double before = accountedWater(s);
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, h), 1u);
+  const Particles& p = s.state.particles;
+  ASSERT_EQ(p.size(), size_t(s.model.numCloth) + 1);
+  const size_t q = p.size() - 1;
+  EXPECT_EQ(p.mass[q], thr);
+  EXPECT_NEAR(p.radius[q], std::cbrt(thr / s.model.water.particleMass) * s.model.water.supportRadius, 1e-7f);
+  EXPECT_LT(p.x[q].y(), 0.9f);                                          // below the cloth
+  EXPECT_LE(densityAt(s, rig.s, q), s.model.water.restDensity * 1.001f);  // no density spike
+  EXPECT_GT(densityAt(s, rig.s, q), 0.5f * s.model.water.restDensity);  // but close to the cloth
+  EXPECT_NEAR(s.state.clothBuffer[bottom], 0.25 * thr, 1e-12);
+  EXPECT_NEAR(accountedWater(s), before, 1e-12);
+  ASSERT_EQ(s.state.dripId.size(), 1u);
+  EXPECT_EQ(s.state.dripId[0], p.id[q]);
+  EXPECT_EQ(s.state.ledger.dripsEmitted, 1u);
+
+  // Eq. 19: the cloth pulls its drip up towards it
+  applyDripAttraction(s.model, s.state, rig.nb, rig.s, h);
+  EXPECT_GT(p.v[q].y(), 0.0f);
+  // the buffer feeds the hanging drip instead of starting a second one
+  s.state.clothBuffer[bottom] += 1.0 * thr;
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, h), 0u);
+  EXPECT_EQ(p.size(), q + 1);
+  EXPECT_NEAR(p.mass[q], 2.25f * thr, 1e-7f);
+  EXPECT_NEAR(s.state.clothBuffer[bottom], 0.0, 1e-9);
+  EXPECT_NEAR(accountedWater(s), before + thr, 1e-9);
+}
+
+TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
+  // held water above S^EW goes to the buffers, and the buffers move down (Eq. 18)
+  Scene s = sceneFromJson(R"({"cloth": [)" +
+                          rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
+                          R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
+  StageRig rig;
+  rig.refresh(s.state, s.model);
+  const double before = accountedWater(s);
+  const auto rowBuffer = [&](int r) {
+    double b = 0.0;
+    for (int c = 0; c < 11; ++c) b += s.state.clothBuffer[size_t(r * 11 + c)];
+    return b;
+  };
+  for (int it = 0; it < 20; ++it) emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, s.model.solver.dt);
+  EXPECT_NEAR(accountedWater(s), before, 1e-12 * before);
+  // held water is capped at S^EW
+  for (float si : s.state.clothSaturation) EXPECT_LE(si, s.model.wetting.saturationEmit * (1.0f + 1e-5f));
+  // the bottom row gathered the excess of the rows above; the top row, fed by nobody, drained
+  EXPECT_GT(rowBuffer(0), 2.0 * rowBuffer(10));
+  EXPECT_LT(rowBuffer(20), 0.5 * rowBuffer(10));
+  // without gravity nothing moves down: every buffer keeps its own excess
+  Scene flat = sceneFromJson(R"({"solver": {"gravity": [0, 0, 0]}, "cloth": [)" +
+                             rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
+                             R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
+  rig.refresh(flat.state, flat.model);
+  emitExcessWater(flat.model, flat.state, rig.nb, rig.grid, rig.s, flat.model.solver.dt);
+  const size_t mid = 10 * 11 + 5;
+  EXPECT_NEAR(flat.state.clothBuffer[mid], (0.4 - 0.35) * rig.s.volume[mid] / flat.model.wetting.c, 1e-9);
+}
+
+TEST(WettingEmission, SaturatedHangingClothDrainsAndDrips) {
+  // Fig. 6, scaled down: a saturated cloth hung by two corners; the excess gathers at the bottom edge,
+  // forms drips there and the drips fall
+  Scene s = sceneFromJson(R"({"solver": {"dt": 0.015, "substeps": 2},
+      "cloth": [)" + rectangleJson("s", Vec3(0, 1, 0), 0.3f, 0.3f, 16, 16, "[1, 0, 0]", "[0, 1, 0]",
+                                   R"({"corners": [2, 3]})") +
+                          R"(], "wetting": {"saturation": {"initial": 0.4}}})");
+  const double emitted = s.state.ledger.emitted;
+  WorkspacePtr ws = makeWorkspace();
+  StepStats st;
+  double maxBufferBeforeFirstDrip = 0.0;
+  for (int k = 0; k < 150; ++k) {
+    if (s.state.ledger.dripsEmitted == 0)
+      maxBufferBeforeFirstDrip = std::max(maxBufferBeforeFirstDrip,
+                                          *std::max_element(s.state.clothBuffer.begin(), s.state.clothBuffer.end()));
+    step(s.model, s.state, *ws, s.model.solver.dt, st);
+  }
+  EXPECT_GT(s.state.ledger.dripsEmitted, 0u);
+  EXPECT_LT(maxBufferBeforeFirstDrip, double(s.model.wetting.massThreshold));
+  EXPECT_NEAR(accountedWater(s), emitted, 1e-9 * emitted);
+  // some drip fell well below the cloth's lowest point
+  const Particles& p = s.state.particles;
+  float lowestCloth = 1e9f, lowestWater = 1e9f;
+  for (size_t i = 0; i < p.size(); ++i)
+    (i < size_t(s.model.numCloth) ? lowestCloth : lowestWater) =
+        std::min(i < size_t(s.model.numCloth) ? lowestCloth : lowestWater, p.x[i].y());
+  EXPECT_TRUE(lowestWater < lowestCloth - 0.1f || s.state.ledger.particlesRemovedAtBounds > 0);
+}
