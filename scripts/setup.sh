@@ -4,7 +4,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev
-          libtinyobjloader-dev libgtest-dev libgmock-dev)
+          libtinyobjloader-dev libgtest-dev libgmock-dev
+          libopenvdb-dev libboost-iostreams-dev povray ffmpeg)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

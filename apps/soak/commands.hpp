@@ -1,7 +1,13 @@
 // the subcommands of the soak program; each returns the process exit code
 #pragma once
+#include "render/render.hpp"
+
 #include <string>
 #include <vector>
+
+namespace CLI {
+class App;
+}
 
 namespace soak::cli {
 
@@ -44,6 +50,23 @@ struct BenchOptions {
 int runCommand(const RunOptions& o);
 int validateCommand(const ValidateOptions& o);
 int benchCommand(const BenchOptions& o);
+
+// `soak render` and `soak surface` (apps/soak/render.cpp, docs/rendering.md): each adds its
+// subcommand and options to the parser
+struct RenderCliOptions {
+  RenderOptions options;
+  bool surface = false, particles = false;  // water style flags
+  std::string camera, lookAt;               // "X,Y,Z"
+  bool quiet = false;
+};
+struct SurfaceCliOptions {
+  SurfaceOptions options;
+  bool quiet = false;
+};
+CLI::App* addRenderCommand(CLI::App& app, RenderCliOptions& o);
+CLI::App* addSurfaceCommand(CLI::App& app, SurfaceCliOptions& o);
+int renderCommand(RenderCliOptions& o);
+int surfaceCommand(SurfaceCliOptions& o);
 
 // "a b 'c d'": argv joined with shell quoting where needed
 std::string joinCommandLine(const std::vector<std::string>& args);

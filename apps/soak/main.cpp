@@ -1,4 +1,4 @@
-// soak command-line program: run, validate and bench scenes (docs/cli.md)
+// soak command-line program: run, validate and bench scenes, render and mesh their output (docs/cli.md)
 #include "commands.hpp"
 
 #include <soak/error.hpp>
@@ -71,6 +71,11 @@ int realMain(int argc, char** argv) {
                      "run every scene in this process (peak memory is then shared between scenes)");
   benchCmd->add_flag("-q,--quiet", bench.quiet, "print no table (with --json)");
 
+  RenderCliOptions render;
+  CLI::App* renderCmd = addRenderCommand(app, render);
+  SurfaceCliOptions surface;
+  CLI::App* surfaceCmd = addSurfaceCommand(app, surface);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -79,6 +84,8 @@ int realMain(int argc, char** argv) {
   }
   if (*runCmd) return runCommand(run);
   if (*valCmd) return validateCommand(val);
+  if (*renderCmd) return renderCommand(render);
+  if (*surfaceCmd) return surfaceCommand(surface);
   return benchCommand(bench);
 }
 

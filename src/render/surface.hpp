@@ -1,0 +1,100 @@
+// water surface from particles (docs/rendering.md, "Water surface"): each particle becomes a ball,
+// the balls are unioned into a narrow-band level set (OpenVDB ParticlesToLevelSet), smoothed and
+// eroded (LevelSetFilter) and meshed (volumeToMesh). OpenVDB stays inside surface.cpp.
+#pragma once
+#include <soak/math.hpp>
+#include <soak/model.hpp>
+
+#include <array>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace soak {
+
+struct SurfaceSettings {
+  // voxel edge (m); 0: a sixth of the median support radius h (a third of the Table 1 spacing)
+  float voxelSize = 0.0f;
+  // ball radius of a particle as a fraction of its support radius h_i: h/2 is the spacing r0 at
+  // Table 1 values, so the balls of neighbours overlap and a block has no holes
+  float radiusFraction = 0.5f;
+  // distance the smoothed surface is moved inwards, as a fraction of the median h. The union of
+  // balls of radius r0 reaches r0 past the outer particles (less in the dimples between them); a
+  // lattice block's cells end r0/2 past them. 3/16 h was calibrated so resting blocks of 6^3 to
+  // 24^3 particles enclose their lattice volume to within 5% (tests/render/surface_test.cpp)
+  float erosionFraction = 0.1875f;
+  // a particle whose centre ends up outside the smoothed, eroded surface or less than a quarter of
+  // a drop radius inside it (a drip, a splash: the smoothing removes lone balls) is added back as a ball of
+  // this fraction of its h; 5/16 h is the
+  // radius of the sphere holding a Table 1 particle's volume (m / rho0)
+  float dropFraction = 0.3125f;
+  // Gaussian smoothing passes (width 1 voxel) of the level set before the erosion
+  int smoothingIterations = 1;
+  // narrow band half width in voxels
+  float halfWidth = 3.0f;
+};
+
+// a triangle mesh, outward facing: counter-clockwise seen from outside
+struct SurfaceMesh {
+  std::vector<Vec3> vertices;                 // m
+  std::vector<Vec3> normals;                  // unit, area weighted, one per vertex
+  std::vector<std::array<int, 3>> triangles;  // 0-based vertex indices
+};
+
+// the narrow-band level set of a water surface (an openvdb::FloatGrid behind a pointer)
+class WaterLevelSet {
+ public:
+  struct Impl;
+  explicit WaterLevelSet(std::unique_ptr<Impl> impl);
+  ~WaterLevelSet();
+  WaterLevelSet(WaterLevelSet&&) noexcept;
+  WaterLevelSet& operator=(WaterLevelSet&&) noexcept;
+
+  float voxelSize() const;
+  size_t activeVoxels() const;
+  // particles added back as single balls (dropFraction) after the smoothing
+  size_t dropParticles() const;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// the level set of the particles at x with support radii h (one per particle); balls under 1.5
+// voxels are enlarged to that size (OpenVDB's sampling limit) so that no particle is lost. Throws soak::Error
+// when the sizes differ or a setting is out of range.
+WaterLevelSet waterLevelSet(std::span<const Vec3> x, std::span<const float> h, const SurfaceSettings& settings);
+
+// the zero isosurface as triangles (quads split), outward facing
+SurfaceMesh levelSetMesh(const WaterLevelSet& levelSet);
+
+// the zero level of a mesh collider's signed distance grid as triangles, in the collider's local frame
+// (for drawing it; the grid is what the solver sees)
+SurfaceMesh sdfGridMesh(const SdfGrid& grid);
+
+// volume enclosed by a closed, outward-facing mesh (divergence theorem), m^3
+double enclosedVolume(const SurfaceMesh& mesh);
+
+// writes the level set as a VDB file with one grid named "surface" (class level set) and the frame
+// metadata given; throws soak::Error naming the file
+void writeLevelSetVdb(const std::string& path, const WaterLevelSet& levelSet, int frame, double time);
+
+// what a VDB file written by writeLevelSetVdb holds (for checks and tools)
+struct VdbSummary {
+  bool levelSet = false;    // the grid "surface" is of class level set
+  size_t activeVoxels = 0;
+  float voxelSize = 0.0f;   // m
+  int frame = -1;           // the "frame" metadata
+  double time = 0.0;        // s, the "time" metadata
+};
+// reads the grid "surface" of a VDB file; throws soak::Error naming the file
+VdbSummary readLevelSetVdb(const std::string& path);
+
+// water_surface_NNNN.obj: `v`, `vn` and 1-based `f a//a b//b c//c`
+void writeSurfaceObj(const std::string& path, const SurfaceMesh& mesh);
+
+// water_surface_NNNN.ply: binary little endian, float x y z nx ny nz and list uchar int vertex_indices
+void writeSurfacePly(const std::string& path, const SurfaceMesh& mesh);
+
+}  // namespace soak
