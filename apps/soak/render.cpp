@@ -1,19 +1,17 @@
 // `soak render` and `soak surface`: options, a progress bar and a summary around src/render/
-#include "commands.hpp"
-
-#include <soak/error.hpp>
-
-#include "progress.hpp"
 #include "render/render.hpp"
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <soak/error.hpp>
 #include <sstream>
 
-#include <unistd.h>
+#include "commands.hpp"
+#include "progress.hpp"
 
 namespace soak::cli {
 
@@ -46,9 +44,9 @@ class FrameBar {
   void update(int done, int total) {
     if (!enabled_ || total <= 0) return;
     const double elapsed = seconds();
-    const std::string info = fmt::format("{} {}/{}  {} elapsed  ETA {}", what_, done, total,
-                                         Progress::formatDuration(elapsed),
-                                         Progress::formatDuration(elapsed / done * (total - done)));
+    const std::string info =
+        fmt::format("{} {}/{}  {} elapsed  ETA {}", what_, done, total, Progress::formatDuration(elapsed),
+                    Progress::formatDuration(elapsed / done * (total - done)));
     if (tty_) {
       constexpr int kWidth = 30;
       const int filled = done * kWidth / total;
@@ -106,6 +104,8 @@ CLI::App* addRenderCommand(CLI::App& app, RenderCliOptions& o) {
   cmd->add_option("--elevation", o.options.camera.elevationDegrees,
                   "automatic camera: degrees above the horizontal (default 25)")
       ->check(CLI::Range(-89.0, 89.0));
+  cmd->add_option("--zoom", o.options.camera.zoom, "automatic camera: move closer by this factor (default 1)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--fps", o.options.fps, "video frame rate (default: real time, 1 / (stepsPerFrame dt))")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("!--no-video", o.options.video, "PNG frames only, no movie.mp4");
@@ -128,7 +128,8 @@ CLI::App* addSurfaceCommand(CLI::App& app, SurfaceCliOptions& o) {
   cmd->add_option("--frames", o.options.frames, "frames A:B (inclusive; A:, :B, A; default: all)");
   cmd->add_option("--voxel", o.options.settings.voxelSize, "voxel size in m (default: h/6)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--radius", o.options.settings.radiusFraction, "ball radius per particle, fraction of h (default 0.5)")
+  cmd->add_option("--radius", o.options.settings.radiusFraction,
+                  "ball radius per particle, fraction of h (default 0.5)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--erosion", o.options.settings.erosionFraction,
                   "inward offset after smoothing, fraction of h (default 0.1875)")
@@ -171,9 +172,8 @@ int surfaceCommand(SurfaceCliOptions& o) {
   bar.finish();
   if (!o.quiet) {
     std::string kinds;
-    for (const char* k : {"obj", "ply", "vdb"})
-      if ((k[0] == 'o' && o.options.obj) || (k[0] == 'p' && o.options.ply) || (k[0] == 'v' && o.options.vdb))
-        kinds += std::string(kinds.empty() ? "water_surface_NNNN." : ", .") + k;
+    for (const auto& [ext, on] : {std::pair{"obj", o.options.obj}, {"ply", o.options.ply}, {"vdb", o.options.vdb}})
+      if (on) kinds += std::string(kinds.empty() ? "water_surface_NNNN." : ", .") + ext;
     std::printf("soak: wrote the water surface of %s to %s (%s), voxel %.4g m, in %s\n", frameSpan(res.frames).c_str(),
                 res.outDir.c_str(), kinds.c_str(), res.voxelSize, Progress::formatDuration(bar.seconds()).c_str());
   }

@@ -1,20 +1,20 @@
 // POV-Ray scene text of one frame (docs/rendering.md)
 #include "render/pov.hpp"
 
-#include "world/container.hpp"
-#include "world/mesh_sdf.hpp"
-
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 
+#include "world/container.hpp"
+#include "world/mesh_sdf.hpp"
+
 namespace soak {
 
 namespace {
 
-const Vec3 kFabric(0.80f, 0.74f, 0.62f);       // plain cloth without saturation
+const Vec3 kFabric(0.80f, 0.74f, 0.62f);  // plain cloth without saturation
 const Vec3 kColliderColor(0.55f, 0.60f, 0.68f);
 
 using Buf = fmt::memory_buffer;
@@ -25,14 +25,61 @@ void v3(Buf& b, const Vec3& v) { fmt::format_to(std::back_inserter(b), "<{:.6g},
 void transform(Buf& b, const ColliderPose& pose) {
   const Eigen::Matrix3f r = pose.rotation.toRotationMatrix();
   const Vec3& t = pose.translation;
-  fmt::format_to(std::back_inserter(b), "  matrix <{:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}>\n",
+  fmt::format_to(std::back_inserter(b),
+                 "  matrix <{:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}>\n",
                  r(0, 0), r(1, 0), r(2, 0), r(0, 1), r(1, 1), r(2, 1), r(0, 2), r(1, 2), r(2, 2), t.x(), t.y(), t.z());
 }
 
+// a vertex without a usable normal gets one from its triangles (or +y) so POV-Ray shades it
 std::vector<Vec3> usableNormals(const std::vector<Vec3>& x, const std::vector<Vec3>& given,
-                                const std::vector<std::array<int, 3>>& tris);
+                                const std::vector<std::array<int, 3>>& tris) {
+  std::vector<Vec3> n(x.size(), Vec3::Zero());
+  for (const auto& t : tris) {
+    const Vec3 f = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+    for (int k = 0; k < 3; ++k) n[t[k]] += f;
+  }
+  for (size_t i = 0; i < n.size(); ++i) {
+    const Vec3& g = i < given.size() ? given[i] : Vec3::Zero();
+    const Vec3& use = g.squaredNorm() > 0.25f ? g : n[i];
+    const float len = use.norm();
+    n[i] = len > 1e-20f && std::isfinite(len) ? Vec3(use / len) : Vec3(0, 1, 0);
+  }
+  return n;
+}
+
 void mesh2(Buf& b, const std::vector<Vec3>& x, const std::vector<Vec3>& normals,
-           const std::vector<std::array<int, 3>>& tris, const std::vector<Vec3>& color, const char* material);
+           const std::vector<std::array<int, 3>>& tris, const std::vector<Vec3>& color, const char* material) {
+  b.append(std::string_view("mesh2 {\n  vertex_vectors { "));
+  fmt::format_to(std::back_inserter(b), "{}", x.size());
+  for (const Vec3& p : x) {
+    b.append(std::string_view(",\n"));
+    v3(b, p);
+  }
+  fmt::format_to(std::back_inserter(b), " }}\n  normal_vectors {{ {}", normals.size());
+  for (const Vec3& n : normals) {
+    b.append(std::string_view(",\n"));
+    v3(b, n);
+  }
+  b.append(std::string_view(" }\n"));
+  const bool perVertex = color.size() == x.size();
+  if (perVertex) {
+    fmt::format_to(std::back_inserter(b), "  texture_list {{ {}", color.size());
+    for (const Vec3& c : color)
+      fmt::format_to(std::back_inserter(b),
+                     ",\n texture {{ pigment {{ srgb <{:.4f},{:.4f},{:.4f}> }} finish {{ ClothFinish }} }}", c.x(),
+                     c.y(), c.z());
+    b.append(std::string_view(" }\n"));
+  }
+  fmt::format_to(std::back_inserter(b), "  face_indices {{ {}", tris.size());
+  for (const auto& t : tris) {
+    if (perVertex)
+      fmt::format_to(std::back_inserter(b), ",\n<{0},{1},{2}>,{0},{1},{2}", t[0], t[1], t[2]);
+    else
+      fmt::format_to(std::back_inserter(b), ",\n<{},{},{}>", t[0], t[1], t[2]);
+  }
+  b.append(std::string_view(" }\n"));
+  fmt::format_to(std::back_inserter(b), "  {}\n}}\n", material);
+}
 
 void box(Buf& b, const Vec3& centre, const Vec3& half) {
   b.append(std::string_view("  box { "));
@@ -77,64 +124,15 @@ void collider(Buf& b, const Collider& c, const ColliderPose& pose, const Surface
       fmt::format_to(std::back_inserter(b), "sphere {{ <0,0,0>, {:.7g}\n  texture {{ Solid }}\n", c.radius);
       break;
     case ColliderShape::Capsule:
-      fmt::format_to(std::back_inserter(b),
-                     "union {{\n  cylinder {{ <0,{0:.7g},0>, <0,{1:.7g},0>, {2:.7g} }}\n  sphere {{ <0,{0:.7g},0>, {2:.7g} }}\n"
-                     "  sphere {{ <0,{1:.7g},0>, {2:.7g} }}\n  texture {{ Solid }}\n",
-                     -c.halfHeight, c.halfHeight, c.radius);
+      fmt::format_to(
+          std::back_inserter(b),
+          "union {{\n  cylinder {{ <0,{0:.7g},0>, <0,{1:.7g},0>, {2:.7g} }}\n  sphere {{ <0,{0:.7g},0>, {2:.7g} }}\n"
+          "  sphere {{ <0,{1:.7g},0>, {2:.7g} }}\n  texture {{ Solid }}\n",
+          -c.halfHeight, c.halfHeight, c.radius);
       break;
   }
   transform(b, pose);
   b.append(std::string_view("}\n"));
-}
-
-// a vertex without a usable normal gets one from its triangles (or +y) so POV-Ray shades it
-std::vector<Vec3> usableNormals(const std::vector<Vec3>& x, const std::vector<Vec3>& given,
-                                const std::vector<std::array<int, 3>>& tris) {
-  std::vector<Vec3> n(x.size(), Vec3::Zero());
-  for (const auto& t : tris) {
-    const Vec3 f = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-    for (int k = 0; k < 3; ++k) n[t[k]] += f;
-  }
-  for (size_t i = 0; i < n.size(); ++i) {
-    const Vec3& g = i < given.size() ? given[i] : Vec3::Zero();
-    const Vec3& use = g.squaredNorm() > 0.25f ? g : n[i];
-    const float len = use.norm();
-    n[i] = len > 1e-20f && std::isfinite(len) ? Vec3(use / len) : Vec3(0, 1, 0);
-  }
-  return n;
-}
-
-void mesh2(Buf& b, const std::vector<Vec3>& x, const std::vector<Vec3>& normals,
-           const std::vector<std::array<int, 3>>& tris, const std::vector<Vec3>& color, const char* material) {
-  b.append(std::string_view("mesh2 {\n  vertex_vectors { "));
-  fmt::format_to(std::back_inserter(b), "{}", x.size());
-  for (const Vec3& p : x) {
-    b.append(std::string_view(",\n"));
-    v3(b, p);
-  }
-  fmt::format_to(std::back_inserter(b), " }}\n  normal_vectors {{ {}", normals.size());
-  for (const Vec3& n : normals) {
-    b.append(std::string_view(",\n"));
-    v3(b, n);
-  }
-  b.append(std::string_view(" }\n"));
-  const bool perVertex = color.size() == x.size();
-  if (perVertex) {
-    fmt::format_to(std::back_inserter(b), "  texture_list {{ {}", color.size());
-    for (const Vec3& c : color)
-      fmt::format_to(std::back_inserter(b), ",\n texture {{ pigment {{ srgb <{:.4f},{:.4f},{:.4f}> }} finish {{ ClothFinish }} }}",
-                     c.x(), c.y(), c.z());
-    b.append(std::string_view(" }\n"));
-  }
-  fmt::format_to(std::back_inserter(b), "  face_indices {{ {}", tris.size());
-  for (const auto& t : tris) {
-    if (perVertex)
-      fmt::format_to(std::back_inserter(b), ",\n<{0},{1},{2}>,{0},{1},{2}", t[0], t[1], t[2]);
-    else
-      fmt::format_to(std::back_inserter(b), ",\n<{},{},{}>", t[0], t[1], t[2]);
-  }
-  b.append(std::string_view(" }\n"));
-  fmt::format_to(std::back_inserter(b), "  {}\n}}\n", material);
 }
 
 }  // namespace
@@ -160,7 +158,7 @@ Bounds colliderBounds(const Collider& c, const ColliderPose& pose) {
       if (c.sdf) {
         local.add(c.sdf->origin);
         local.add(c.sdf->origin + c.sdf->cellSize * Vec3(float(c.sdf->dims[0] - 1), float(c.sdf->dims[1] - 1),
-                                                          float(c.sdf->dims[2] - 1)));
+                                                         float(c.sdf->dims[2] - 1)));
       }
       break;
     case ColliderShape::Box:
@@ -241,7 +239,7 @@ CameraSpec CameraFit::camera() const {
   float dist = 0.0f;
   for (int k = 0; k < 4; ++k) dist = std::max(dist, support_[k] - cam.lookAt.dot(direction_[k]));
   const float size = (bounds_.hi - bounds_.lo).norm();
-  dist = std::max(dist * 1.06f, 0.05f * size + 1e-3f);
+  dist = std::max(dist * 1.06f, 0.05f * size + 1e-3f) / request_.zoom;
   cam.position = cam.lookAt + dist * toCamera_;
   return cam;
 }
@@ -272,28 +270,35 @@ std::string povScene(const PovFrameInput& in) {
   const CameraSpec& cam = in.camera;
   const float aspect = static_cast<float>(in.width) / static_cast<float>(in.height);
   fmt::format_to(std::back_inserter(b), "// soak frame: {}\n#version 3.7;\n", in.title);
-  b.append(std::string_view(
-      "global_settings { assumed_gamma 1.0 max_trace_level 12 ambient_light rgb <1,1,1> }\n"
-      "#declare ClothFinish = finish { ambient 0.12 diffuse 0.8 specular 0.08 roughness 0.05 }\n"
-      "#declare Solid = texture { pigment { rgb "));
+  b.append(
+      std::string_view("global_settings { assumed_gamma 1.0 max_trace_level 12 ambient_light rgb <1,1,1> }\n"
+                       "#declare ClothFinish = finish { ambient 0.12 diffuse 0.8 specular 0.08 roughness 0.05 }\n"
+                       "#declare Solid = texture { pigment { rgb "));
   v3(b, kColliderColor);
   b.append(std::string_view(
       " } finish { ambient 0.12 diffuse 0.75 specular 0.3 roughness 0.02 } }\n"
-      "#declare Glass = texture { pigment { rgbt <0.80,0.86,0.92,0.75> } finish { ambient 0.1 diffuse 0.3 specular 0.6 roughness 0.01 } }\n"
+      "#declare Glass = texture { pigment { rgbt <0.80,0.86,0.92,0.75> } finish { ambient 0.1 diffuse 0.3 specular 0.6 "
+      "roughness 0.01 } }\n"
       "#declare WaterSurface = material { texture { pigment { rgbf <0.70,0.85,1.0,0.75> }\n"
       "  finish { ambient 0.05 diffuse 0.25 specular 0.9 roughness 0.003 reflection 0.08 } } interior { ior 1.33 } }\n"
-      "#declare WaterDrop = texture { pigment { rgb <0.16,0.42,0.85> } finish { ambient 0.15 diffuse 0.7 specular 0.6 roughness 0.01 } }\n"));
-  fmt::format_to(std::back_inserter(b),
-                 "#declare Floor = texture {{ pigment {{ checker rgb <0.78,0.78,0.76> rgb <0.62,0.63,0.64> scale {:.6g} }}\n"
-                 "  finish {{ ambient 0.12 diffuse 0.8 }} }}\n",
-                 in.checker);
-  b.append(std::string_view(
-      "sky_sphere { pigment { gradient y color_map { [0.0 rgb <0.93,0.94,0.96>] [1.0 rgb <0.55,0.68,0.86>] } scale 2 translate -1 } }\n"));
+      "#declare WaterDrop = texture { pigment { rgb <0.16,0.42,0.85> } finish { ambient 0.15 diffuse 0.7 specular 0.6 "
+      "roughness 0.01 } }\n"));
+  fmt::format_to(
+      std::back_inserter(b),
+      "#declare Floor = texture {{ pigment {{ checker rgb <0.78,0.78,0.76> rgb <0.62,0.63,0.64> scale {:.6g} }}\n"
+      "  finish {{ ambient 0.12 diffuse 0.8 }} }}\n",
+      in.checker);
+  b.append(
+      std::string_view("sky_sphere { pigment { gradient y color_map { [0.0 rgb <0.93,0.94,0.96>] [1.0 rgb "
+                       "<0.55,0.68,0.86>] } scale 2 translate -1 } }\n"));
   // right-handed data: a negative right vector (POV-Ray documentation, "camera")
   b.append(std::string_view("camera {\n  location "));
   v3(b, cam.position);
-  fmt::format_to(std::back_inserter(b), "\n  sky <0,1,0>\n  up y\n  right -x*{:.6g}\n  angle {:.6g}\n  look_at ", aspect,
-                 cam.fovDegrees);
+  // y is the sky, unless the camera looks straight up or down: then -z is up in the picture
+  const Vec3 dir = (cam.lookAt - cam.position).normalized();
+  const char* sky = std::abs(dir.y()) > 0.9999f ? "<0,0,-1>" : "<0,1,0>";
+  fmt::format_to(std::back_inserter(b), "\n  sky {}\n  up y\n  right -x*{:.6g}\n  angle {:.6g}\n  look_at ", sky,
+                 aspect, cam.fovDegrees);
   v3(b, cam.lookAt);
   b.append(std::string_view("\n}\n"));
   // a key light above and to the left of the camera, a soft fill from its right
@@ -317,8 +322,9 @@ std::string povScene(const PovFrameInput& in) {
   if (in.cloth != nullptr && !in.cloth->triangles.empty()) {
     const ClothFrame& c = *in.cloth;
     b.append(std::string_view("// cloth\n"));
-    const std::string plain = fmt::format("texture {{ pigment {{ srgb <{:.4f},{:.4f},{:.4f}> }} finish {{ ClothFinish }} }}",
-                                          kFabric.x(), kFabric.y(), kFabric.z());
+    const std::string plain =
+        fmt::format("texture {{ pigment {{ srgb <{:.4f},{:.4f},{:.4f}> }} finish {{ ClothFinish }} }}", kFabric.x(),
+                    kFabric.y(), kFabric.z());
     mesh2(b, c.x, usableNormals(c.x, c.normal, c.triangles), c.triangles, in.clothColor,
           in.clothColor.size() == c.x.size() ? "" : plain.c_str());
   }

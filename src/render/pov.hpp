@@ -3,16 +3,15 @@
 // pose, a floor, lights. POV-Ray is left-handed; soak is right-handed with y up, so the camera's
 // right vector is negated (POV-Ray's documented way to render right-handed data).
 #pragma once
+#include <optional>
 #include <soak/math.hpp>
 #include <soak/model.hpp>
+#include <string>
+#include <vector>
 
 #include "render/run_output.hpp"
 #include "render/surface.hpp"
 #include "world/colliders.hpp"
-
-#include <optional>
-#include <string>
-#include <vector>
 
 namespace soak {
 
@@ -38,6 +37,7 @@ struct CameraRequest {
   float fovDegrees = 40.0f;        // horizontal field of view
   float azimuthDegrees = 35.0f;    // direction to the camera around y, from +z towards +x
   float elevationDegrees = 25.0f;  // above the horizontal
+  float zoom = 1.0f;               // the automatic distance is divided by this
 };
 
 // automatic framing: collects points (and boxes) and places the camera to look at the centre of their
@@ -68,20 +68,20 @@ CameraSpec frameCamera(const Bounds& bounds, const CameraRequest& request, int w
 enum class WaterStyle { Surface, Particles };
 
 struct PovFrameInput {
-  const Model* model = nullptr;            // colliders
-  std::vector<ColliderPose> poses;         // one per collider, at the frame's time
+  const Model* model = nullptr;                  // colliders
+  std::vector<ColliderPose> poses;               // one per collider, at the frame's time
   std::vector<const SurfaceMesh*> colliderMesh;  // per collider: the mesh of a Mesh collider, else null
   const ClothFrame* cloth = nullptr;
-  std::vector<Vec3> clothColor;            // per cloth vertex (0..1); empty: the plain fabric colour
+  std::vector<Vec3> clothColor;  // per cloth vertex (0..1); empty: the plain fabric colour
   WaterStyle water = WaterStyle::Particles;
-  const SurfaceMesh* surface = nullptr;    // WaterStyle::Surface
-  std::vector<Vec3> dropCentre;            // WaterStyle::Particles: sphere centres (m)
-  std::vector<float> dropRadius;           // and radii (m)
+  const SurfaceMesh* surface = nullptr;  // WaterStyle::Surface
+  std::vector<Vec3> dropCentre;          // WaterStyle::Particles: sphere centres (m)
+  std::vector<float> dropRadius;         // and radii (m)
   CameraSpec camera;
   int width = 640, height = 480;
-  std::optional<float> floorY;             // draw a floor plane at this height (no plane collider)
-  float checker = 0.1f;                    // m, side of a floor square
-  std::string title;                       // a comment line
+  std::optional<float> floorY;  // draw a floor plane at this height (no plane collider)
+  float checker = 0.1f;         // m, side of a floor square
+  std::string title;            // a comment line
 };
 
 // the saturation ramp of the paper: dry colour (red Fig. 3, green Fig. 4) to black at S^MAX, linear in

@@ -1,9 +1,12 @@
 // posix_spawn with a time limit: the renderer must never wait on a prompt or a stuck tool
 #include "render/process.hpp"
 
-#include <soak/error.hpp>
-
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -11,13 +14,8 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <soak/error.hpp>
 #include <thread>
-
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 extern char** environ;
 

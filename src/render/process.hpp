@@ -14,9 +14,9 @@ std::string findExecutable(const std::string& name);
 std::string requireExecutable(const std::string& name, const std::string& package, const std::string& hint = "");
 
 struct ProcessResult {
-  int exitCode = -1;       // when it exited
-  int signal = 0;          // when a signal ended it
-  bool timedOut = false;   // it ran past the limit and was killed
+  int exitCode = -1;      // when it exited
+  int signal = 0;         // when a signal ended it
+  bool timedOut = false;  // it ran past the limit and was killed
   bool ok() const { return !timedOut && signal == 0 && exitCode == 0; }
   std::string describe() const;  // "exit code 2", "killed by signal 11", "no result within 30 s"
 };

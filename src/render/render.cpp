@@ -1,12 +1,6 @@
 // rendering a run: frame bounds -> one camera -> a .pov per frame -> POV-Ray in parallel -> ffmpeg
 #include "render/render.hpp"
 
-#include <soak/error.hpp>
-
-#include "io/file.hpp"
-#include "render/process.hpp"
-#include "world/colliders.hpp"
-
 #include <fmt/format.h>
 
 #include <atomic>
@@ -14,7 +8,12 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <soak/error.hpp>
 #include <thread>
+
+#include "io/file.hpp"
+#include "render/process.hpp"
+#include "world/colliders.hpp"
 
 namespace soak {
 
@@ -31,6 +30,7 @@ void checkOptions(const RenderOptions& o) {
   if (!(o.fps >= 0.0)) throw Error(fmt::format("--fps: expected a rate > 0 (or 0 for real time), got {}", o.fps));
   if (!(o.timeoutSeconds > 0.0)) throw Error(fmt::format("--timeout: expected seconds > 0, got {}", o.timeoutSeconds));
   if (!(o.antialias >= 0.0f)) throw Error(fmt::format("--antialias: expected a threshold >= 0, got {}", o.antialias));
+  if (!(o.camera.zoom > 0.0f)) throw Error(fmt::format("--zoom: expected a factor > 0, got {}", o.camera.zoom));
   if (!(o.camera.fovDegrees > 1.0f && o.camera.fovDegrees < 179.0f))
     throw Error(fmt::format("--fov: expected 1..179 degrees, got {}", o.camera.fovDegrees));
   if (o.camera.position && o.camera.lookAt && (*o.camera.position - *o.camera.lookAt).norm() < 1e-6f)
@@ -111,16 +111,17 @@ std::string renderFrame(const FrameJob& job, int frame) {
   writeTextFile((fs::path(job.workDir) / pov).string(), povScene(in));
   std::error_code ec;
   fs::remove(fs::path(job.workDir) / log, ec);
-  std::vector<std::string> args = {job.povray, "+I" + pov, "+O" + png, fmt::format("+W{}", o.width),
-                                   fmt::format("+H{}", o.height), "+FN", "-D", "-P", "-V",
-                                   fmt::format("+WT{}", job.povThreads)};
+  std::vector<std::string> args = {
+      job.povray, "+I" + pov, "+O" + png, fmt::format("+W{}", o.width),        fmt::format("+H{}", o.height), "+FN",
+      "-D",       "-P",       "-V",       fmt::format("+WT{}", job.povThreads)};
   if (o.antialias > 0.0f) args.push_back(fmt::format("+A{:.3g}", o.antialias));
   const ProcessResult r = runProcess(args, job.workDir, (fs::path(job.workDir) / log).string(), o.timeoutSeconds);
   const std::string where = (fs::path(job.workDir) / pov).string();
   if (r.timedOut)
-    throw Error(fmt::format("povray did not finish frame {} within {} s and was stopped (raise --timeout, or lower "
-                            "--width/--height); its scene is {}",
-                            frame, o.timeoutSeconds, where));
+    throw Error(
+        fmt::format("povray did not finish frame {} within {} s and was stopped (raise --timeout, or lower "
+                    "--width/--height); its scene is {}",
+                    frame, o.timeoutSeconds, where));
   const fs::path made = fs::path(job.workDir) / png;
   if (!r.ok() || !fs::exists(made, ec))
     throw Error(fmt::format("povray failed on frame {} ({}); its scene is {}; the end of its log:\n{}", frame,
@@ -155,10 +156,23 @@ std::string encodeVideo(const std::string& ffmpeg, const RenderResult& res, cons
   const std::string log = (fs::path(workDir) / "ffmpeg.log").string();
   fs::remove(log, ec);
   // libx264 with yuv420p needs even sizes: pad by one pixel when odd
-  const std::vector<std::string> args = {ffmpeg, "-nostdin", "-y", "-loglevel", "error", "-framerate",
-                                         fmt::format("{:.6g}", res.fps), "-i", (seq / "v_%06d.png").string(),
-                                         "-c:v", "libx264", "-pix_fmt", "yuv420p", "-vf",
-                                         "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-movflags", "+faststart",
+  const std::vector<std::string> args = {ffmpeg,
+                                         "-nostdin",
+                                         "-y",
+                                         "-loglevel",
+                                         "error",
+                                         "-framerate",
+                                         fmt::format("{:.6g}", res.fps),
+                                         "-i",
+                                         (seq / "v_%06d.png").string(),
+                                         "-c:v",
+                                         "libx264",
+                                         "-pix_fmt",
+                                         "yuv420p",
+                                         "-vf",
+                                         "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                         "-movflags",
+                                         "+faststart",
                                          fs::absolute(video).string()};
   const ProcessResult r = runProcess(args, "", log, timeout);
   fs::remove_all(seq, ec);
@@ -171,6 +185,7 @@ std::string encodeVideo(const std::string& ffmpeg, const RenderResult& res, cons
 }  // namespace
 
 SurfaceResult surfaceRun(const SurfaceOptions& o, const std::function<void(int, int)>& progress) {
+  if (!o.obj && !o.ply && !o.vdb) throw Error("soak surface: nothing to write (--no-obj and --no-vdb without --ply)");
   const RunOutput run = openRunOutput(o.runDir);
   SurfaceResult res;
   res.frames = selectFrames(run, o.frames);

@@ -1,21 +1,20 @@
 // a run's output folder read back: scene.json, the frame files present, stats.jsonl times
 #include "render/run_output.hpp"
 
-#include <soak/error.hpp>
-
-#include "io/file.hpp"
-#include "io/ply.hpp"
-
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <charconv>
-#include <limits>
 #include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
+#include <soak/error.hpp>
 #include <sstream>
+
+#include "io/file.hpp"
+#include "io/ply.hpp"
 
 namespace soak {
 
@@ -59,7 +58,8 @@ std::map<int, double> readStatsTimes(const std::string& path) {
 }
 
 Vec3 vecAt(const PlyElement& e, const char* a, const char* b, const char* c, size_t i) {
-  return Vec3(static_cast<float>(e.scalar(a)[i]), static_cast<float>(e.scalar(b)[i]), static_cast<float>(e.scalar(c)[i]));
+  return Vec3(static_cast<float>(e.scalar(a)[i]), static_cast<float>(e.scalar(b)[i]),
+              static_cast<float>(e.scalar(c)[i]));
 }
 
 std::vector<std::array<int, 3>> plyTriangles(const PlyElement& faces, const std::string& path, size_t vertices) {
@@ -129,13 +129,15 @@ ClothFrame clothFromObj(const std::string& path) {
       for (std::string tok; ls >> tok;) {
         int id = 0;
         const auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), id);
-        if (ec != std::errc() || id == 0) throw bad("expected 'f a b c' with 1-based vertex indices, got '" + tok + "'");
+        if (ec != std::errc() || id == 0)
+          throw bad("expected 'f a b c' with 1-based vertex indices, got '" + tok + "'");
         if (p == tok.data()) throw bad("bad face index '" + tok + "'");
         ids.push_back(id < 0 ? static_cast<int>(c.x.size()) + id : id - 1);
       }
       if (ids.size() < 3) throw bad("a face needs at least 3 vertices");
       for (int id : ids)
-        if (id < 0 || static_cast<size_t>(id) >= c.x.size()) throw bad(fmt::format("face vertex {} does not exist yet", id + 1));
+        if (id < 0 || static_cast<size_t>(id) >= c.x.size())
+          throw bad(fmt::format("face vertex {} does not exist yet", id + 1));
       for (size_t k = 1; k + 1 < ids.size(); ++k) c.triangles.push_back({ids[0], ids[k], ids[k + 1]});
     }
   }
@@ -163,7 +165,8 @@ RunOutput openRunOutput(const std::string& dir) {
   if (!fs::is_directory(dir, ec)) throw Error(dir + ": not a folder (expected the output folder of `soak run`)");
   const std::string scenePath = (fs::path(dir) / "scene.json").string();
   if (!fs::exists(scenePath, ec))
-    throw Error(dir + ": not a soak output folder: scene.json is missing (make one with `soak run SCENE -o " + dir + "`)");
+    throw Error(dir + ": not a soak output folder: scene.json is missing (make one with `soak run SCENE -o " + dir +
+                "`)");
   RunOutput run;
   run.dir = dir;
   run.scene = loadScene(scenePath);
@@ -186,7 +189,8 @@ std::vector<int> selectFrames(const RunOutput& run, const std::string& range) {
       const std::string a = range.substr(0, colon), b = range.substr(colon + 1);
       ok = (a.empty() || parseInt(a, lo)) && (b.empty() || parseInt(b, hi));
     }
-    if (!ok) throw Error("--frames: expected A:B, A:, :B or A with frame numbers >= 0 (e.g. 0:100), got '" + range + "'");
+    if (!ok)
+      throw Error("--frames: expected A:B, A:, :B or A with frame numbers >= 0 (e.g. 0:100), got '" + range + "'");
     if (hi < lo) throw Error("--frames: '" + range + "' ends before it starts");
   }
   std::vector<int> out;
@@ -219,9 +223,11 @@ WaterFrame readWaterFrame(const RunOutput& run, int frame) {
   const float mass = run.scene.model.water.particleMass, h = run.scene.model.water.supportRadius;
   w.mass.assign(v.count, mass);
   w.radius.assign(v.count, h);
-  if (v.has("mass")) std::transform(v.scalar("mass").begin(), v.scalar("mass").end(), w.mass.begin(), [](double m) { return float(m); });
+  if (v.has("mass"))
+    std::transform(v.scalar("mass").begin(), v.scalar("mass").end(), w.mass.begin(), [](double m) { return float(m); });
   if (v.has("radius"))
-    std::transform(v.scalar("radius").begin(), v.scalar("radius").end(), w.radius.begin(), [](double r) { return float(r); });
+    std::transform(v.scalar("radius").begin(), v.scalar("radius").end(), w.radius.begin(),
+                   [](double r) { return float(r); });
   return w;
 }
 

@@ -1,11 +1,10 @@
 // reading back the output folder of `soak run` (docs/output-format.md) for the renderer and the
 // surface command: the scene as run, the frames present, and each frame's cloth and water
 #pragma once
-#include <soak/math.hpp>
-#include <soak/scene.hpp>
-
 #include <array>
 #include <map>
+#include <soak/math.hpp>
+#include <soak/scene.hpp>
 #include <string>
 #include <vector>
 
@@ -13,9 +12,9 @@ namespace soak {
 
 struct RunOutput {
   std::string dir;
-  Scene scene;                        // DIR/scene.json, loaded and validated
-  std::vector<int> frames;            // frame numbers with at least one frame file, ascending
-  std::map<int, double> statsTime;    // s, the "time" of each stats.jsonl line (when present)
+  Scene scene;                      // DIR/scene.json, loaded and validated
+  std::vector<int> frames;          // frame numbers with at least one frame file, ascending
+  std::map<int, double> statsTime;  // s, the "time" of each stats.jsonl line (when present)
 
   // simulated time of a frame: stats.jsonl's, else frame * stepsPerFrame * dt
   double timeOf(int frame) const;
@@ -42,9 +41,9 @@ struct ClothFrame {
 };
 
 struct WaterFrame {
-  std::vector<Vec3> x;         // m
-  std::vector<float> mass;     // kg
-  std::vector<float> radius;   // m, support radius h
+  std::vector<Vec3> x;        // m
+  std::vector<float> mass;    // kg
+  std::vector<float> radius;  // m, support radius h
 };
 
 // throw soak::Error naming the file when a file is malformed

@@ -1,23 +1,21 @@
 // water surface: particles -> narrow-band level set -> smoothed, eroded -> triangle mesh (OpenVDB)
 #include "render/surface.hpp"
 
-#include <soak/error.hpp>
-
-#include "io/file.hpp"
-#include "world/mesh_sdf.hpp"
-
+#include <fmt/format.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetFilter.h>
 #include <openvdb/tools/ParticlesToLevelSet.h>
 #include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <soak/error.hpp>
+
+#include "io/file.hpp"
+#include "world/mesh_sdf.hpp"
 
 namespace soak {
 
@@ -71,8 +69,10 @@ void checkSettings(const SurfaceSettings& s) {
                             s.radiusFraction, s.erosionFraction));
   if (s.smoothingIterations < 0)
     throw Error(fmt::format("water surface: smoothing iterations must be >= 0, got {}", s.smoothingIterations));
-  if (!(s.dropFraction >= 0.0f)) throw Error(fmt::format("water surface: drop fraction must be >= 0, got {}", s.dropFraction));
-  if (!(s.halfWidth >= 2.0f)) throw Error(fmt::format("water surface: half width must be >= 2 voxels, got {}", s.halfWidth));
+  if (!(s.dropFraction >= 0.0f))
+    throw Error(fmt::format("water surface: drop fraction must be >= 0, got {}", s.dropFraction));
+  if (!(s.halfWidth >= 2.0f))
+    throw Error(fmt::format("water surface: half width must be >= 2 voxels, got {}", s.halfWidth));
 }
 
 std::vector<Vec3> vertexNormals(const SurfaceMesh& m) {
@@ -92,8 +92,7 @@ std::vector<Vec3> vertexNormals(const SurfaceMesh& m) {
 }  // namespace
 
 WaterLevelSet waterLevelSet(std::span<const Vec3> x, std::span<const float> h, const SurfaceSettings& settings) {
-  if (x.size() != h.size())
-    throw Error(fmt::format("water surface: {} positions but {} radii", x.size(), h.size()));
+  if (x.size() != h.size()) throw Error(fmt::format("water surface: {} positions but {} radii", x.size(), h.size()));
   checkSettings(settings);
   initOpenVdb();
   const float hMedian = h.empty() ? 0.04f : median(h);

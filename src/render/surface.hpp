@@ -2,11 +2,10 @@
 // the balls are unioned into a narrow-band level set (OpenVDB ParticlesToLevelSet), smoothed and
 // eroded (LevelSetFilter) and meshed (volumeToMesh). OpenVDB stays inside surface.cpp.
 #pragma once
-#include <soak/math.hpp>
-#include <soak/model.hpp>
-
 #include <array>
 #include <memory>
+#include <soak/math.hpp>
+#include <soak/model.hpp>
 #include <span>
 #include <string>
 #include <vector>
@@ -82,11 +81,11 @@ void writeLevelSetVdb(const std::string& path, const WaterLevelSet& levelSet, in
 
 // what a VDB file written by writeLevelSetVdb holds (for checks and tools)
 struct VdbSummary {
-  bool levelSet = false;    // the grid "surface" is of class level set
+  bool levelSet = false;  // the grid "surface" is of class level set
   size_t activeVoxels = 0;
-  float voxelSize = 0.0f;   // m
-  int frame = -1;           // the "frame" metadata
-  double time = 0.0;        // s, the "time" metadata
+  float voxelSize = 0.0f;  // m
+  int frame = -1;          // the "frame" metadata
+  double time = 0.0;       // s, the "time" metadata
 };
 // reads the grid "surface" of a VDB file; throws soak::Error naming the file
 VdbSummary readLevelSetVdb(const std::string& path);

@@ -1,25 +1,24 @@
 // soak render and soak surface end to end (the soak binary, POV-Ray, ffmpeg) and the pieces they use:
 // camera framing, saturation colours, colliders at their keyframed pose, clear errors, no hang
-#include <gtest/gtest.h>
-
-#include "io/file.hpp"
-#include "io/ply.hpp"
-#include "render/pov.hpp"
-#include "render/process.hpp"
 #include "render/render.hpp"
-#include "render/run_output.hpp"
-#include "world/colliders.hpp"
 
-#include <soak/error.hpp>
-#include <soak/scene.hpp>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include "io/file.hpp"
+#include "io/ply.hpp"
+#include "render/pov.hpp"
+#include "render/process.hpp"
+#include "render/run_output.hpp"
+#include "world/colliders.hpp"
 
 namespace soak {
 namespace {
@@ -108,8 +107,8 @@ class Folder {
 std::array<int, 3> pixel(const std::string& png, int x, int y, const Folder& tmp) {
   const auto [w, h] = pngSize(png);
   const std::string raw = (tmp / "pixels.rgb").string();
-  const std::string cmd = "ffmpeg -nostdin -loglevel error -y -i '" + png + "' -f rawvideo -pix_fmt rgb24 '" + raw +
-                          "' < /dev/null";
+  const std::string cmd =
+      "ffmpeg -nostdin -loglevel error -y -i '" + png + "' -f rawvideo -pix_fmt rgb24 '" + raw + "' < /dev/null";
   EXPECT_EQ(std::system(cmd.c_str()), 0);
   const std::string bytes = readTextFile(raw);
   EXPECT_EQ(bytes.size(), size_t(3 * w * h));
@@ -141,7 +140,8 @@ TEST(RenderRun, OddSizesAndParticlesAndAFrameRange) {
   const Folder tmp("odd");
   const std::string run = tmp.tinyRun();
   const std::string out = (tmp / "odd").string();
-  const Result r = tmp.soak("render '" + run + "' -o '" + out + "' --width 51 --height 37 --particles --frames 2:3 --keep-pov -q");
+  const Result r =
+      tmp.soak("render '" + run + "' -o '" + out + "' --width 51 --height 37 --particles --frames 2:3 --keep-pov -q");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());
   EXPECT_FALSE(fs::exists(fs::path(out) / "frame_0001.png"));
@@ -154,7 +154,8 @@ TEST(RenderRun, OddSizesAndParticlesAndAFrameRange) {
   const size_t water = pov.find("// water particles");
   ASSERT_NE(water, std::string::npos);
   size_t spheres = 0;
-  for (size_t at = pov.find("sphere { <", water); at != std::string::npos; at = pov.find("sphere { <", at + 1)) ++spheres;
+  for (size_t at = pov.find("sphere { <", water); at != std::string::npos; at = pov.find("sphere { <", at + 1))
+    ++spheres;
   EXPECT_EQ(spheres, 64u);
   EXPECT_EQ(pov.find("WaterSurface }"), std::string::npos);
 }
@@ -174,8 +175,9 @@ TEST(RenderRun, ClothColourFollowsSaturation) {
   }
   for (const char* ramp : {"red", "green"}) {
     const std::string out = (tmp / ramp).string();
-    const Result r = tmp.soak("render '" + dir.string() + "' -o '" + out + "' --ramp " + ramp +
-                              " --width 40 --height 30 --camera 0,1.4,0.3 --look-at 0,0.5,0 --fov 20 --no-video --no-floor -q");
+    const Result r =
+        tmp.soak("render '" + dir.string() + "' -o '" + out + "' --ramp " + ramp +
+                 " --width 40 --height 30 --camera 0,1.4,0.3 --look-at 0,0.5,0 --fov 20 --no-video --no-floor -q");
     ASSERT_EQ(r.code, 0) << r.err;
     const auto dry = pixel(out + "/frame_0000.png", 20, 15, tmp);
     const auto half = pixel(out + "/frame_0001.png", 20, 15, tmp);
@@ -324,6 +326,43 @@ TEST(RenderCamera, AutomaticFramingShowsEveryCornerAndFillsThePicture) {
         }
         EXPECT_GT(widest, 0.85f) << "the bounds should fill the picture, az " << az << " el " << el;
       }
+}
+
+TEST(RenderCamera, EveryPointAddedIsInThePictureAndZoomMovesCloser) {
+  // a cloud of points with radii (water particles), one stray drop far to the side
+  CameraRequest req;
+  CameraFit fit(req, 480, 360);
+  std::vector<std::pair<Vec3, float>> pts;
+  uint32_t seed = 12345;
+  auto rnd = [&seed] {
+    seed = seed * 1664525u + 1013904223u;
+    return float(seed >> 8) / float(1 << 24);
+  };
+  for (int i = 0; i < 500; ++i) pts.push_back({Vec3(rnd() - 0.5f, 2.0f * rnd(), rnd() - 0.5f), 0.02f});
+  pts.push_back({Vec3(1.4f, 0.1f, -0.9f), 0.0125f});
+  for (const auto& [p, r] : pts) fit.add(p, r);
+  const CameraSpec cam = fit.camera();
+  const Vec3 fwd = (cam.lookAt - cam.position).normalized();
+  const Vec3 right = fwd.cross(Vec3(0, 1, 0)).normalized();
+  const Vec3 up = right.cross(fwd);
+  const float tanH = std::tan(0.5f * cam.fovDegrees * kPi / 180.0f), tanV = tanH * 360.0f / 480.0f;
+  float widest = 0.0f;
+  for (const auto& [p, r] : pts) {
+    const Vec3 d = p - cam.position;
+    const float depth = d.dot(fwd);
+    // the ball's silhouette edge: centre offset plus its radius
+    const float sx = (std::abs(d.dot(right)) + r) / depth / tanH, sy = (std::abs(d.dot(up)) + r) / depth / tanV;
+    EXPECT_LE(sx, 1.0f);
+    EXPECT_LE(sy, 1.0f);
+    widest = std::max({widest, sx, sy});
+  }
+  EXPECT_GT(widest, 0.85f);
+  req.zoom = 2.0f;
+  CameraFit closer(req, 480, 360);
+  for (const auto& [p, r] : pts) closer.add(p, r);
+  const CameraSpec zoomed = closer.camera();
+  EXPECT_NEAR((zoomed.position - zoomed.lookAt).norm(), 0.5f * (cam.position - cam.lookAt).norm(), 1e-4f);
+  EXPECT_EQ(zoomed.lookAt, cam.lookAt);
 }
 
 TEST(RenderCamera, UserCameraIsKept) {

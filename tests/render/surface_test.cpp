@@ -1,17 +1,16 @@
 // the water surface (OpenVDB level set and mesh) against the volume of the particles it wraps
-#include <gtest/gtest.h>
-
-#include "io/ply.hpp"
 #include "render/surface.hpp"
-#include "world/mesh_sdf.hpp"
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
 #include <soak/error.hpp>
 
-#include <filesystem>
-#include <cmath>
-#include <map>
-
-#include <unistd.h>
+#include "io/ply.hpp"
+#include "world/mesh_sdf.hpp"
 
 namespace soak {
 namespace {
@@ -106,8 +105,10 @@ TEST(SurfaceVolume, LoneDropsStayAsBallsOfTheirVolume) {
   double big = 0.0, small = 0.0;
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
     const Vec3& p = mesh.vertices[i];
-    if (p.x() < 0.15f) big = std::max(big, double(p.norm()));
-    else small = std::max(small, double((p - x[1]).norm()));
+    if (p.x() < 0.15f)
+      big = std::max(big, double(p.norm()));
+    else
+      small = std::max(small, double((p - x[1]).norm()));
   }
   EXPECT_NEAR(big, r, 0.5 * ls.voxelSize());
   // the half-size drip is 0.00625 m, under 1.5 voxels: enlarged to 1.5 voxels so it shows
