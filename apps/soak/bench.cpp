@@ -171,6 +171,7 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   stage("colliders", &StageTimes::colliders);
   stage("velocities", &StageTimes::velocities);
   stage("wetting", &StageTimes::wetting);
+  stage("garment", &StageTimes::garment);
   stage("total", &StageTimes::total);
   double meanTotal = 0.0;
   uint64_t contacts = 0;
@@ -244,9 +245,9 @@ json runInChild(const BenchJob& job, const BenchOptions& o, int index) {
 std::string mib(double bytes) { return fmt::format("{:.1f}", bytes / (1024.0 * 1024.0)); }
 
 void printTable(const std::vector<json>& results) {
-  std::printf("%-18s %9s %7s %11s %9s %8s %8s %8s %9s %8s %8s %9s %9s %6s  %s\n", "scene", "water", "cloth",
-              "it f/c/cp/s", "neighbors", "water", "cloth", "coupling", "colliders", "total", "mean", "ns/p/step",
-              "peak MiB", "B/p", "target");
+  std::printf("%-18s %9s %7s %11s %9s %8s %8s %8s %9s %8s %8s %8s %8s %9s %9s %6s  %s\n", "scene", "water",
+              "cloth", "it f/c/cp/s", "neighbors", "water", "cloth", "coupling", "colliders", "wetting", "garment",
+              "total", "mean", "ns/p/step", "peak MiB", "B/p", "target");
   for (const json& r : results) {
     if (r.contains("error")) {
       std::printf("%-18s %s\n", r["name"].get<std::string>().c_str(), r["error"].get<std::string>().c_str());
@@ -261,14 +262,15 @@ void printTable(const std::vector<json>& results) {
     if (r["targets"].contains("bytesPerParticleMet"))
       target += fmt::format("{} {} B/p", r["targets"]["bytesPerParticleMet"].get<bool>() ? "met" : "MISSED",
                             r["targets"]["targetBytesPerParticle"].get<double>());
-    std::printf("%-18s %9llu %7llu %11s %9.2f %8.2f %8.2f %8.2f %9.2f %8.2f %8.2f %9.1f %9s %6.0f  %s\n",
+    std::printf("%-18s %9llu %7llu %11s %9.2f %8.2f %8.2f %8.2f %9.2f %8.2f %8.2f %8.2f %8.2f %9.1f %9s %6.0f  %s\n",
                 r["name"].get<std::string>().c_str(), r["particles"]["water"].get<unsigned long long>(),
                 r["particles"]["cloth"].get<unsigned long long>(),
                 fmt::format("{}/{}/{}/{}", it["fluid"].get<int>(), it["cloth"].get<int>(), it["coupling"].get<int>(),
                             it["substeps"].get<int>())
                     .c_str(),
                 ms["neighbors"].get<double>(), ms["water"].get<double>(), ms["cloth"].get<double>(),
-                ms["coupling"].get<double>(), ms["colliders"].get<double>(), ms["total"].get<double>(),
+                ms["coupling"].get<double>(), ms["colliders"].get<double>(), ms["wetting"].get<double>(),
+                ms["garment"].get<double>(), ms["total"].get<double>(),
                 r["msPerStepMean"].get<double>(), r["nsPerParticleStep"].get<double>(),
                 mib(r["peakRssBytes"].get<double>()).c_str(), r["bytesPerParticle"].get<double>(), target.c_str());
   }

@@ -6,6 +6,7 @@
 #include <soak/step.hpp>
 
 #include "core/parallel.hpp"
+#include "garment/stage.hpp"
 #include "io/file.hpp"
 #include "io/output.hpp"
 #include "io/stats.hpp"
@@ -95,6 +96,7 @@ nlohmann::ordered_json waterJson(const WaterMass& w, const State& s) {
           {"emittedKg", w.emitted},
           {"removedAtBoundsKg", w.removedAtBounds},
           {"particlesRemovedAtBounds", s.ledger.particlesRemovedAtBounds},
+          {"takenByClothKg", w.takenByCloth},
           {"unaccountedKg", w.emitted - w.total}};
 }
 
@@ -197,9 +199,15 @@ int runCommand(const RunOptions& o) {
       const std::string bad = checkState(model, state);
       // a diverged frame is written too: it shows where the blow-up started
       // the cloth's saturation (Eq. 10) as a PLY attribute and as the paper's colours in the OBJ
-      const std::vector<Vec3> colors = saturationColors(model, state, out.colorRamp);
+      std::vector<Vec3> colors = saturationColors(model, state, out.colorRamp);
       std::vector<PlyFloatAttribute> extras;
       if (model.wetting.enabled) extras.push_back({"saturation", state.clothSaturation});
+      std::vector<float> wetness;  // Chen 2012 pieces without Shao's wetting: Q(t) / delta, same ramp
+      if (!model.wetting.enabled && !state.clothWetStart.empty()) {
+        wetness = clothWetness(model, state);
+        extras.push_back({"wetness", wetness});
+        colors = rampColors(wetness, 1.0f, out.colorRamp);
+      }
       writeFrameFiles(dir.string(), model, state, out, frame, extras, colors);
       nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
       if (!bad.empty()) line["error"] = bad;
@@ -236,9 +244,10 @@ int runCommand(const RunOptions& o) {
                 Progress::formatDuration(simSeconds).c_str(),
                 state.stepCount > 0 ? 1e3 * simSeconds / static_cast<double>(state.stepCount) : 0.0, threadCount());
     std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
-                "removed at bounds %.6g kg (%llu particles); unaccounted %.3g kg\n",
+                "removed at bounds %.6g kg (%llu particles) + taken in by garments %.6g kg; unaccounted %.3g kg\n",
                 w.emitted, w.free, w.heldInCloth, w.inBuffers, w.removedAtBounds,
-                static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.emitted - w.total);
+                static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.takenByCloth,
+                w.emitted - w.total);
   }
   return kExitOk;
 }
@@ -258,7 +267,9 @@ int validateCommand(const ValidateOptions& o) {
   std::printf("  cloth:       %zu pieces, %zu triangles, %zu pinned particles\n", m.pieces.size(), m.triangles.size(),
               pinned);
   for (const ClothPiece& p : m.pieces)
-    std::printf("    %-12s %d particles, %d triangles\n", p.name.c_str(), p.particleCount, p.triangleCount);
+    std::printf("    %-12s %d particles, %d triangles, %s solver%s\n", p.name.c_str(), p.particleCount, p.triangleCount,
+                p.solver == ClothSolver::Implicit ? "implicit (Chen 2012)" : "PBD",
+                p.garment.saturationMass ? ", saturation mass (Eq. 15-19)" : "");
   std::printf("  colliders:   %zu\n", m.colliders.size());
   for (const Collider& c : m.colliders) std::printf("    %s\n", c.name.c_str());
   std::printf("  emitters:    %zu\n", m.emitters.size());

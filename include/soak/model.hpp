@@ -1,6 +1,7 @@
 // Model: everything that stays constant during a run (topology, rest shape, parameters, colliders,
 // emitters). Built once by the scene loader; read-only for the step.
 #pragma once
+#include <soak/garment_params.hpp>
 #include <soak/math.hpp>
 #include <soak/params.hpp>
 
@@ -70,11 +71,20 @@ struct Emitter {
 
 // a cloth piece occupies particles [firstParticle, firstParticle + particleCount) and triangles
 // [firstTriangle, firstTriangle + triangleCount); cloth particles come before every water particle
+enum class ClothSolver { Pbd, Implicit };
+
 struct ClothPiece {
   std::string name;
   int firstParticle = 0, particleCount = 0;
   int firstTriangle = 0, triangleCount = 0;
   ClothMaterial material;
+  // Chen 2012 (docs/garment.md): Implicit pieces are solved by src/garment, not by the PBD stages
+  ClothSolver solver = ClothSolver::Pbd;
+  GarmentParams garment;            // implicit solver parameters; garment.saturationMass / .saturation
+                                    // (Eq. 15-19) also apply to a PBD piece
+  bool wetByContact = false;        // the piece keeps a wet start time per vertex (State::clothWetStart)
+  bool dropsVanish = true;          // a water particle that wets the piece (no Shao wetting) is taken in
+  std::vector<int> panelOfVertex;   // wrinkle subdomains of a procedural garment; empty: patches
 };
 
 // Eq. 8 constraints as a struct of arrays; solved colour by colour (no two share a particle)
@@ -113,6 +123,7 @@ struct Model {
   std::vector<Vec3> clothRestPosition;           // m, per cloth particle (initial shape)
   std::vector<float> clothDryMass;               // kg, per cloth particle
   std::vector<uint8_t> clothPinned;              // 1 = follows clothRestPosition (kinematic)
+  std::vector<uint8_t> clothImplicit;            // 1 = in a piece solved implicitly (skipped by the PBD stages)
   std::vector<int> vertexTriangleStart;          // CSR: triangles around a cloth particle
   std::vector<int> vertexTriangles;
   std::vector<int> vertexNeighborStart;          // CSR: cloth particles sharing an edge (1-ring)
@@ -123,6 +134,16 @@ struct Model {
 
   std::vector<Collider> colliders;
   std::vector<Emitter> emitters;
+
+  // particle i is a cloth particle of a piece solved implicitly (Chen 2012), which the PBD stages skip
+  bool implicitCloth(int64_t i) const {
+    return i >= 0 && i < static_cast<int64_t>(clothImplicit.size()) && clothImplicit[static_cast<size_t>(i)] != 0;
+  }
+  bool hasImplicitCloth() const {
+    for (const ClothPiece& piece : pieces)
+      if (piece.solver == ClothSolver::Implicit) return true;
+    return false;
+  }
 };
 
 }  // namespace soak

@@ -35,6 +35,8 @@ struct WaterLedger {
   double inBuffers = 0.0;          // kg, excess water in the emission buffers (section 4.4)
   uint64_t particlesAbsorbed = 0;  // water particles absorbed whole (Eq. 11)
   uint64_t dripsEmitted = 0;       // drip particles created from the buffers (section 4.4)
+  double takenByCloth = 0.0;       // kg, water particles that wetted a Chen 2012 piece and vanished into it
+  uint64_t particlesTakenByCloth = 0;
 };
 
 struct EmitterState {
@@ -57,6 +59,9 @@ struct State {
   std::vector<float> clothSaturation;  // S_i of Eq. 10 at the last wetting stage
   std::vector<uint32_t> dripId;        // ids of the drips hanging from the cloth (Eq. 19), ascending
   std::vector<int32_t> dripSource;     // the cloth particle each drip hangs from
+  // Chen 2012 saturation mass and wet friction: the time each cloth particle first got wet
+  // (+infinity: dry); one entry per cloth particle when a piece has wetByContact, else empty
+  std::vector<float> clothWetStart;
 };
 
 }  // namespace soak

@@ -6,11 +6,30 @@ namespace soak {
 
 struct StageTimes {         // ms of wall time per stage
   double emit = 0, predict = 0, neighbors = 0, water = 0, cloth = 0, coupling = 0, colliders = 0,
-         velocities = 0, wetting = 0, total = 0;
+         velocities = 0, wetting = 0, garment = 0, total = 0;
   StageTimes& operator+=(const StageTimes& o) {
     emit += o.emit; predict += o.predict; neighbors += o.neighbors; water += o.water; cloth += o.cloth;
     coupling += o.coupling; colliders += o.colliders; velocities += o.velocities; wetting += o.wetting;
-    total += o.total;
+    garment += o.garment; total += o.total;
+    return *this;
+  }
+};
+
+// the implicit garment solves of Chen 2012 (src/garment), summed over substeps and pieces
+struct GarmentStats {
+  uint64_t solves = 0;          // implicit steps taken (pieces x substeps)
+  uint64_t cgIterations = 0;    // summed over the solves
+  int cgIterationsMax = 0;
+  double maxResidual = 0.0;     // largest relative CG residual at exit
+  uint64_t unconverged = 0;     // solves whose CG stopped at garment.cg.maxIterations (the step still ran)
+  uint64_t breakdowns = 0;      // solves whose system was not positive definite
+  uint64_t contacts = 0;        // vertex-collider contacts
+  uint64_t disturbances = 0;    // wrinkle constraints applied (section 3.5)
+  uint64_t dropsTaken = 0;      // water particles that wetted a piece and vanished into it
+  GarmentStats& operator+=(const GarmentStats& o) {
+    solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
+    maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
+    breakdowns += o.breakdowns; contacts += o.contacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     return *this;
   }
 };
@@ -23,6 +42,7 @@ struct StepStats {
   uint64_t removedParticles = 0;    // water particles that left the domain this step
   float meanDensityRatio = 0.0f;    // mean rho_i / rho_0 over water particles after the solve
   float maxSpeed = 0.0f;            // m/s over all particles
+  GarmentStats garment;
 };
 
 }  // namespace soak

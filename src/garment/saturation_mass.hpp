@@ -5,7 +5,7 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
-#include "garment/params.hpp"
+#include <soak/garment_params.hpp>
 
 #include <limits>
 #include <span>

@@ -16,7 +16,7 @@
 #include <soak/math.hpp>
 #include <soak/model.hpp>
 
-#include "garment/params.hpp"
+#include <soak/garment_params.hpp>
 
 #include <array>
 #include <cstdint>

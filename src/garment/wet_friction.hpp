@@ -5,7 +5,7 @@
 #pragma once
 #include <soak/math.hpp>
 
-#include "garment/params.hpp"
+#include <soak/garment_params.hpp>
 
 namespace soak {
 

@@ -8,7 +8,7 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
-#include "garment/params.hpp"
+#include <soak/garment_params.hpp>
 
 #include "garment/springs.hpp"
 #include "world/colliders.hpp"

@@ -16,6 +16,7 @@ void FrameStats::add(const StepStats& s) {
   removedParticles += s.removedParticles;
   densityRatioSum += s.meanDensityRatio;
   maxSpeed = std::max(maxSpeed, s.maxSpeed);
+  garment += s.garment;
 }
 
 WaterMass waterMass(const State& state) {
@@ -27,7 +28,8 @@ WaterMass waterMass(const State& state) {
   for (double m : state.clothBuffer) w.inBuffers += m;
   w.emitted = state.ledger.emitted;
   w.removedAtBounds = state.ledger.removedAtBounds;
-  w.total = w.free + w.heldInCloth + w.inBuffers + w.removedAtBounds;
+  w.takenByCloth = state.ledger.takenByCloth;
+  w.total = w.free + w.heldInCloth + w.inBuffers + w.removedAtBounds + w.takenByCloth;
   return w;
 }
 
@@ -41,7 +43,7 @@ static nlohmann::ordered_json stageJson(const StageTimes& t) {
   return {{"emit", t.emit},         {"predict", t.predict},     {"neighbors", t.neighbors},
           {"water", t.water},       {"cloth", t.cloth},         {"coupling", t.coupling},
           {"colliders", t.colliders}, {"velocities", t.velocities}, {"wetting", t.wetting},
-          {"total", t.total}};
+          {"garment", t.garment},   {"total", t.total}};
 }
 
 nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, int frame, const FrameStats& fs) {
@@ -57,11 +59,28 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
   j["substeps"] = fs.substeps;
   j["counts"] = {{"water", water}, {"cloth", model.numCloth}};
   j["waterMass"] = {{"free", w.free},       {"heldInCloth", w.heldInCloth},         {"inBuffers", w.inBuffers},
-                    {"emitted", w.emitted}, {"removedAtBounds", w.removedAtBounds}, {"total", w.total}};
+                    {"emitted", w.emitted}, {"removedAtBounds", w.removedAtBounds},
+                    {"takenByCloth", w.takenByCloth}, {"total", w.total}};
   if (model.wetting.enabled)
     j["wetting"] = {{"particlesAbsorbed", state.ledger.particlesAbsorbed},
                     {"dripsEmitted", state.ledger.dripsEmitted},
                     {"dripsHanging", state.dripId.size()}};
+  if (model.hasImplicitCloth() || !state.clothWetStart.empty()) {
+    const GarmentStats& g = fs.garment;
+    uint64_t wet = 0;
+    for (float t : state.clothWetStart) wet += std::isfinite(t) ? 1 : 0;
+    j["garment"] = {{"solves", g.solves},
+                    {"cgIterations", g.cgIterations},
+                    {"cgIterationsMax", g.cgIterationsMax},
+                    {"cgMaxResidual", g.maxResidual},
+                    {"unconvergedSolves", g.unconverged},
+                    {"breakdowns", g.breakdowns},
+                    {"contacts", g.contacts},
+                    {"disturbances", g.disturbances},
+                    {"dropsTaken", g.dropsTaken},
+                    {"dropsTakenTotal", state.ledger.particlesTakenByCloth},
+                    {"wetVertices", wet}};
+  }
   j["removedAtBounds"] = {{"frame", fs.removedParticles}, {"total", state.ledger.particlesRemovedAtBounds}};
   j["emittedParticles"] = fs.emittedParticles;
   j["couplingContacts"] = fs.couplingContacts;

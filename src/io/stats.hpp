@@ -22,15 +22,18 @@ struct FrameStats {
   uint64_t removedParticles = 0;
   double densityRatioSum = 0.0;
   float maxSpeed = 0.0f;             // m/s
+  GarmentStats garment;
 
   void add(const StepStats& s);
 };
 
 // where the water is (kg): free particles, held by the cloth, in the cloth's emission buffers
-// (Shao 2017 section 4), emitted so far, removed at the domain bounds; total is
-// free + heldInCloth + inBuffers + removedAtBounds and equals emitted while water is conserved
+// (Shao 2017 section 4), emitted so far, removed at the domain bounds, taken in by Chen 2012 pieces;
+// total is free + heldInCloth + inBuffers + removedAtBounds + takenByCloth and equals emitted while
+// water is conserved
 struct WaterMass {
-  double free = 0.0, heldInCloth = 0.0, inBuffers = 0.0, emitted = 0.0, removedAtBounds = 0.0, total = 0.0;
+  double free = 0.0, heldInCloth = 0.0, inBuffers = 0.0, emitted = 0.0, removedAtBounds = 0.0, takenByCloth = 0.0,
+         total = 0.0;
 };
 WaterMass waterMass(const State& state);
 

@@ -27,9 +27,11 @@ TriangleMesh makeRectangle(const Vec3& center, const Vec3& axisU, const Vec3& ax
 
 // appends a cloth piece to the model: particles' rest data, triangles, and rebuilds stretch/bend
 // constraints, colourings and adjacency. Throws soak::Error (naming `source`) when an edge is shared
-// by more than two triangles, a triangle is degenerate or an index is out of range.
+// by more than two triangles, a triangle is degenerate or an index is out of range. An Implicit
+// piece gets adjacency but no PBD stretch / bend constraints (src/garment builds its springs).
 void addClothPiece(Model& model, const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
-                   const std::vector<int>& pinnedVertices, const std::string& source);
+                   const std::vector<int>& pinnedVertices, const std::string& source,
+                   ClothSolver solver = ClothSolver::Pbd);
 
 // the particle index of vertex 0 of the piece is model.pieces[k].firstParticle
 

@@ -16,6 +16,7 @@ void predictPositions(const Model& model, double /*time*/, Particles& p, float d
   const Vec3 g = model.solver.gravity;
   const int64_t nc = model.numCloth;
   parallelFor(static_cast<int64_t>(p.size()), [&](int64_t i) {
+    if (model.implicitCloth(i)) return;  // garmentSubstep predicts these (src/garment)
     if (i < nc && model.clothPinned[i]) {
       p.xPred[i] = model.clothRestPosition[i];
       p.v[i].setZero();
@@ -30,6 +31,7 @@ void updateVelocities(const Model& model, Particles& p, float dt) {
   const int64_t nc = model.numCloth;
   const float inv = 1.0f / dt;
   parallelFor(static_cast<int64_t>(p.size()), [&](int64_t i) {
+    if (model.implicitCloth(i)) return;  // v from the implicit solve (addCouplingVelocity)
     Vec3 v = (p.xPred[i] - p.x[i]) * inv;
     if (i < nc) v *= std::max(0.0f, 1.0f - dt * model.pieces[clothPiece(p.phase[i])].material.damping);
     p.v[i] = v;

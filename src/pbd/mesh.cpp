@@ -175,6 +175,10 @@ void rebuildTopology(Model& model) {
     const ClothMaterial& mat = model.pieces[triPiece[first.triangle]].material;
     ring[first.lo].push_back(first.hi);
     ring[first.hi].push_back(first.lo);
+    if (model.pieces[triPiece[first.triangle]].solver == ClothSolver::Implicit) {  // springs in src/garment instead
+      s = e;
+      continue;
+    }
 
     // Eq. 8: one stretch constraint per unique edge, rest length from the rest shape
     stretch.ids.push_back({first.lo, first.hi});
@@ -294,7 +298,7 @@ TriangleMesh makeRectangle(const Vec3& center, const Vec3& axisU, const Vec3& ax
 // Cloth pieces are added before any water particle exists. The scene loader then creates one particle
 // per vertex in State, in order, so particle index == piece.firstParticle + vertex index.
 void addClothPiece(Model& model, const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
-                   const std::vector<int>& pinnedVertices, const std::string& source) {
+                   const std::vector<int>& pinnedVertices, const std::string& source, ClothSolver solver) {
   validateMesh(name, mesh, pinnedVertices, source);
 
   ClothPiece piece;
@@ -304,6 +308,7 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
   piece.firstTriangle = static_cast<int>(model.triangles.size());
   piece.triangleCount = static_cast<int>(mesh.triangles.size());
   piece.material = material;
+  piece.solver = solver;
 
   for (const auto& tri : mesh.triangles)
     model.triangles.push_back(
@@ -312,6 +317,8 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
   model.clothDryMass.insert(model.clothDryMass.end(), mesh.vertices.size(), material.particleMass);
   model.clothPinned.insert(model.clothPinned.end(), mesh.vertices.size(), uint8_t{0});
   for (int v : pinnedVertices) model.clothPinned[piece.firstParticle + v] = 1;
+  model.clothImplicit.insert(model.clothImplicit.end(), mesh.vertices.size(),
+                             uint8_t{solver == ClothSolver::Implicit ? uint8_t{1} : uint8_t{0}});
   model.numCloth += piece.particleCount;
   model.pieces.push_back(piece);
 

@@ -2,6 +2,7 @@
 #include <soak/step.hpp>
 
 #include "core/parallel.hpp"
+#include "garment/stage.hpp"
 #include "pbd/integrate.hpp"
 #include "pbd/tethers.hpp"
 #include "pbd/workspace.hpp"
@@ -31,11 +32,13 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   stats.emittedParticles += emitWater(model, state, state.time, h);                 // new water (Fig. 1 jet, Fig. 3 block)
   ms.emit += clock.lap();
   predictPositions(model, state.time + h, p, h);                                    // v += dt g, x* = x + dt v
+  updateColliderPoses(model, state.time + h, ws.poses);
   ms.predict += clock.lap();
+  solveGarments(model, state, ws.garment, ws.poses, h, stats);                      // Chen 2012: Eq. 1-5, 15-19, 3.5
+  ms.garment += clock.lap();
   buildGrid(p.xPred, maxSupportRadius(p), ws.grid);                                 // neighbours of x*
   buildNeighborLists(p.xPred, p.radius, ws.grid, ws.neighbors);
   ms.neighbors += clock.lap();
-  updateColliderPoses(model, state.time + h, ws.poses);
   computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
   scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
   solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
@@ -52,6 +55,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   solveCoupling(model, p, ws.neighbors, ws.coupling, true);                         // no water crosses the cloth
   ms.coupling += clock.lap();
   updateVelocities(model, p, h);                                                    // v = (x* - x) / dt, damping
+  addCouplingVelocity(model, p, ws.garment, h);                                     // implicit cloth pushed by water
   applyColliderRestitution(model, ws.poses, ws.contactNormal, p);
   fluidVelocityPass(model, p, ws.neighbors, ws.fluid, h);                           // XSPH, vorticity
   stats.meanDensityRatio = meanDensityRatio(model, p, ws.fluid);
@@ -65,6 +69,8 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   applySticking(model, state, ws.neighbors, ws.wetting, h);                         // wet cloth sticks (Eq. 20)
   finishWetting(model, state, ws.wetting);                                          // absorbed water leaves; ledger
   ms.wetting += clock.lap();
+  stats.garment.dropsTaken += wetClothByContact(model, state, ws.neighbors, ws.garment, ws.keep, state.time + h);
+  ms.garment += clock.lap();
   stats.removedParticles += removeOutsideDomain(model, state, ws.keep);             // counted in the ledger
   ms.velocities += clock.lap();
   state.time += h;

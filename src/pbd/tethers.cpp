@@ -40,6 +40,7 @@ void buildTethers(Model& model, int maxAnchors) {
   std::vector<std::vector<std::pair<float, int>>> candidates(static_cast<size_t>(n));
   std::vector<float> dist;
   for (const ClothPiece& piece : model.pieces) {
+    if (piece.solver == ClothSolver::Implicit) continue;  // pins are filtered in the implicit solve
     std::vector<int> pins;
     for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i)
       if (model.clothPinned[i]) pins.push_back(i);

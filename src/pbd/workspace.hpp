@@ -2,6 +2,7 @@
 #pragma once
 #include <soak/step.hpp>
 
+#include "garment/stage.hpp"
 #include "grid/grid.hpp"
 #include "pbd/cloth.hpp"
 #include "pbd/coupling.hpp"
@@ -23,6 +24,7 @@ struct Workspace {
   CouplingScratch coupling;
   std::vector<uint8_t> keep;            // particles kept after the domain check
   WettingScratch wetting;               // cloth wetting (Shao 2017 section 4)
+  GarmentScratch garment;               // implicit garments and saturation mass (Chen 2012)
 };
 
 }  // namespace soak

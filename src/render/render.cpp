@@ -87,7 +87,8 @@ std::string renderFrame(const FrameJob& job, int frame) {
   in.poses = posesAt(model, run.timeOf(frame));
   for (const SurfaceMesh& m : job.colliderMeshes) in.colliderMesh.push_back(&m);
   in.cloth = &cloth;
-  in.clothColor = clothColors(cloth, job.ramp, model.wetting.saturationMax);
+  in.clothColor = clothColors(cloth, job.ramp, cloth.saturationMax > 0.0f ? cloth.saturationMax
+                                                                          : model.wetting.saturationMax);
   in.water = o.water;
   SurfaceMesh surface;
   if (o.water == WaterStyle::Surface && !water.x.empty()) {

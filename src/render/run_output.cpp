@@ -94,6 +94,10 @@ ClothFrame clothFromPly(const std::string& path) {
   if (v.has("saturation")) {
     const std::vector<double>& s = v.scalar("saturation");
     c.saturation.assign(s.begin(), s.end());
+  } else if (v.has("wetness")) {  // Q(t) / delta of Chen 2012 pieces: 1 is fully wet
+    const std::vector<double>& s = v.scalar("wetness");
+    c.saturation.assign(s.begin(), s.end());
+    c.saturationMax = 1.0f;
   }
   if (ply.has("face")) c.triangles = plyTriangles(ply.element("face"), path, v.count);
   return c;

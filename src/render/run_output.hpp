@@ -30,13 +30,15 @@ RunOutput openRunOutput(const std::string& dir);
 // empty is every frame). Throws soak::Error for a malformed range or one that selects no frame.
 std::vector<int> selectFrames(const RunOutput& run, const std::string& range);
 
-// the cloth of a frame: from cloth_NNNN.ply (with its "saturation" attribute when present), else
+// the cloth of a frame: from cloth_NNNN.ply (with its "saturation" attribute when present, else its
+// "wetness" in [0, 1] from the Chen 2012 saturation mass), else
 // from cloth_NNNN.obj (with its vertex colours when present); empty when the frame has no cloth file
 struct ClothFrame {
   std::vector<Vec3> x;                        // m
   std::vector<Vec3> normal;                   // unit, one per vertex (zero when the file had none)
   std::vector<std::array<int, 3>> triangles;  // 0-based
   std::vector<float> saturation;              // S_i (Eq. 10) per vertex, empty when absent
+  float saturationMax = 0.0f;                 // the value drawn fully wet; 0: the scene's S^MAX
   std::vector<Vec3> color;                    // 0..1 per vertex from the OBJ, empty when absent
 };
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -13,11 +14,82 @@
 
 #include "pbd/cloth.hpp"
 #include "pbd/tethers.hpp"
+#include "scene/chen_keys.hpp"
+#include "scene/common.hpp"
 #include "scene/overrides.hpp"
 #include "scene/reader.hpp"
 #include "wetting/wetting.hpp"
 
 namespace soak {
+
+std::string fmtVec(const Vec3& v) { return fmt::format("[{}, {}, {}]", v.x(), v.y(), v.z()); }
+
+Quat axisAngle(const Vec3& unitAxis, float degrees) {
+  return Quat(Eigen::AngleAxisf(degrees * kPi / 180.0f, unitAxis)).normalized();
+}
+
+bool checkOrdered(ErrorLog& log, const std::string& maxPath, const std::string& minName, const Vec3& lo,
+                  const Vec3& hi) {
+  if ((hi.array() > lo.array()).all()) return true;
+  log.error(maxPath, fmt::format("expected every component greater than {} {}, got {}", minName, fmtVec(lo), fmtVec(hi)));
+  return false;
+}
+
+Quat readRotation(ObjectReader r) {
+  const Vec3 axis = r.unitVec3("axis", Vec3::UnitY());
+  const float degrees = r.number("degrees", 0.0f);
+  r.finish();
+  return axisAngle(axis, degrees);
+}
+
+std::vector<Keyframe> readPose(ObjectReader& r, bool isPlane) {
+  ErrorLog& log = r.log();
+  const bool hasKeys = r.has("keyframes"), hasPos = r.has("position"), hasRot = r.has("rotation");
+  const bool hasNormal = isPlane && r.has("normal");
+  if (hasKeys && (hasPos || hasRot))
+    log.error(r.pathOf("keyframes"), "expected either position/rotation or keyframes, got both");
+  if (hasNormal && (hasRot || hasKeys))
+    log.error(r.pathOf("normal"), "expected normal alone, got it together with rotation or keyframes");
+  Keyframe still;
+  still.translation = r.vec3("position", Vec3::Zero());
+  still.rotation = readRotation(r.object("rotation"));
+  if (isPlane) {
+    // the rotation taking local +y (the plane's normal) to the given normal
+    const Vec3 normal = r.unitVec3("normal", Vec3::UnitY());
+    if (hasNormal) still.rotation = Quat::FromTwoVectors(Vec3::UnitY(), normal).normalized();
+  }
+  const Json* keys = r.array("keyframes");
+  if (!keys) return {still};
+  if (keys->empty()) {
+    log.expected(r.pathOf("keyframes"), "an array of at least one keyframe", *keys);
+    return {still};
+  }
+  std::vector<Keyframe> out;
+  for (size_t i = 0; i < keys->size(); ++i) {
+    const std::string kp = indexPath(r.pathOf("keyframes"), i);
+    if (!(*keys)[i].is_object()) {
+      log.expected(kp, "an object (a keyframe)", (*keys)[i]);
+      continue;
+    }
+    ObjectReader k(log, &(*keys)[i], kp);
+    Keyframe key;
+    key.time = k.number("time", std::nullopt, Range::nonNegative());
+    key.translation = k.vec3("position", Vec3::Zero());
+    key.rotation = readRotation(k.object("rotation"));
+    k.finish();
+    if (!out.empty() && !(key.time > out.back().time))
+      log.error(k.pathOf("time"), fmt::format("expected a time > the previous keyframe's ({} s), got {}",
+                                              out.back().time, key.time));
+    out.push_back(key);
+  }
+  return out.empty() ? std::vector<Keyframe>{still} : out;
+}
+
+std::string resolvePath(const std::string& file, const std::string& baseDir) {
+  std::filesystem::path resolved(file);
+  if (resolved.is_relative()) resolved = std::filesystem::path(baseDir) / resolved;
+  return resolved.string();
+}
 
 namespace {
 
@@ -30,29 +102,9 @@ struct ClothSpec {
   TriangleMesh mesh;
   ClothMaterial material;
   std::vector<int> pinned;  // mesh vertex indices, sorted, unique
+  ChenClothSpec chen;       // solver, saturation mass, garment settings (Chen 2012)
+  std::vector<int> panelOfVertex;
 };
-
-std::string fmtVec(const Vec3& v) { return fmt::format("[{}, {}, {}]", v.x(), v.y(), v.z()); }
-
-Quat axisAngle(const Vec3& unitAxis, float degrees) {
-  return Quat(Eigen::AngleAxisf(degrees * kPi / 180.0f, unitAxis)).normalized();
-}
-
-// max > min in every component, else an error at maxPath
-bool checkOrdered(ErrorLog& log, const std::string& maxPath, const std::string& minName, const Vec3& lo,
-                  const Vec3& hi) {
-  if ((hi.array() > lo.array()).all()) return true;
-  log.error(maxPath, fmt::format("expected every component greater than {} {}, got {}", minName, fmtVec(lo), fmtVec(hi)));
-  return false;
-}
-
-// {"axis": unit vec3, "degrees": number}
-Quat readRotation(ObjectReader r) {
-  const Vec3 axis = r.unitVec3("axis", Vec3::UnitY());
-  const float degrees = r.number("degrees", 0.0f);
-  r.finish();
-  return axisAngle(axis, degrees);
-}
 
 void readSolver(ObjectReader r, SolverParams& s) {
   const SolverParams d;
@@ -182,9 +234,20 @@ void checkDripThreshold(ErrorLog& log, const Model& model, const std::vector<flo
   }
 }
 
-ClothMaterial readMaterial(ObjectReader r) {
+ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   const ClothMaterial d;
   ClothMaterial m;
+  if (solver == ClothSolver::Implicit) {  // the KES laws, Rayleigh damping and wet friction replace these
+    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction"})
+      if (r.has(key))
+        r.log().error(r.pathOf(key), fmt::format("expected no {} on a piece with \"solver\": \"implicit\" (a PBD "
+                                                 "key; set the garment section instead, docs/scene-format.md)",
+                                                 key));
+    if (const Json* sc = r.get("selfCollision"); sc && sc->is_boolean() && sc->get<bool>())
+      r.log().error(r.pathOf("selfCollision"),
+                    "expected false on a piece with \"solver\": \"implicit\" (the implicit solver has no "
+                    "self-collision), got true");
+  }
   m.particleMass = r.number("particleMass", d.particleMass, Range::positive());
   m.restDensity = r.number("restDensity", d.restDensity, Range::positive());
   m.stretchCompliance = r.number("stretchCompliance", d.stretchCompliance, Range::nonNegative());
@@ -192,7 +255,7 @@ ClothMaterial readMaterial(ObjectReader r) {
   m.damping = r.number("damping", d.damping, Range::nonNegative());
   m.thickness = r.number("thickness", d.thickness, Range::positive());
   m.friction = r.number("friction", d.friction, Range::unit());
-  m.selfCollision = r.boolean("selfCollision", d.selfCollision);
+  m.selfCollision = r.boolean("selfCollision", d.selfCollision) && solver == ClothSolver::Pbd;
   r.finish();
   return m;
 }
@@ -213,19 +276,35 @@ int nearestVertex(const TriangleMesh& mesh, const Vec3& p) {
 const std::vector<std::string> kRectangleKeys = {"center", "size", "resolution", "axisU", "axisV"};
 const std::vector<std::string> kObjKeys = {"path", "scale", "translate", "rotate"};
 
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 // reads "mesh" and builds the triangle mesh; nullopt when it is invalid (errors logged)
 std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir, int maxVertices,
-                                     std::optional<RectangleInfo>& rect) {
+                                     std::optional<RectangleInfo>& rect, const Bodies& bodies,
+                                     std::vector<int>& panelOfVertex) {
   ErrorLog& log = m.log();
   const size_t errorsBefore = log.messages().size();
-  const int type = m.choice("type", {"rectangle", "obj"}, std::nullopt);
+  const int type = m.choice("type", {"rectangle", "obj", "garment"}, std::nullopt);
+  if (type == 2) {
+    std::optional<TriangleMesh> mesh = readGarmentMesh(m, bodies, panelOfVertex);
+    m.finish(concat(kRectangleKeys, kObjKeys), "a garment mesh");
+    if (mesh && int64_t(mesh->vertices.size()) > maxVertices) {
+      log.error(m.path(), fmt::format("expected at most solver.maxParticles ({}) vertices, got {}", maxVertices,
+                                      mesh->vertices.size()));
+      return std::nullopt;
+    }
+    return mesh;
+  }
   if (type == 0) {
     const Vec3 center = m.vec3("center", Vec3::Zero());
     const std::vector<float> size = m.numbers("size", 2, std::nullopt, Range::positive());
     const std::vector<int> res = m.integers("resolution", 2, std::nullopt, Range::atLeast(2));
     const Vec3 u = m.unitVec3("axisU", Vec3::UnitX());
     const Vec3 v = m.unitVec3("axisV", Vec3::UnitZ());
-    m.finish(kObjKeys, "a rectangle mesh");
+    m.finish(concat(kObjKeys, kGarmentMeshKeys), "a rectangle mesh");
     if (std::abs(u.dot(v)) > 1e-3f)
       log.error(m.pathOf("axisV"), fmt::format("expected a direction perpendicular to axisU {}, got {}", fmtVec(u),
                                                fmtVec(v)));
@@ -246,10 +325,9 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
     const float scale = m.number("scale", 1.0f, Range::positive());
     const Vec3 translate = m.vec3("translate", Vec3::Zero());
     const Quat rotate = readRotation(m.object("rotate"));
-    m.finish(kRectangleKeys, "an obj mesh");
+    m.finish(concat(kRectangleKeys, kGarmentMeshKeys), "an obj mesh");
     if (log.messages().size() != errorsBefore) return std::nullopt;
-    fs::path resolved(file);
-    if (resolved.is_relative()) resolved = fs::path(baseDir) / resolved;
+    const fs::path resolved(resolvePath(file, baseDir));
     std::error_code ec;
     if (!fs::is_regular_file(resolved, ec)) {
       log.error(m.pathOf("path"), fmt::format("expected the path of an existing OBJ file, got \"{}\" (tried \"{}\")",
@@ -322,7 +400,8 @@ std::vector<int> readPins(ObjectReader p, const TriangleMesh* mesh, const std::o
 }
 
 std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::string& path, int index,
-                                   const std::string& baseDir, int maxVertices) {
+                                   const std::string& baseDir, int maxVertices, bool shaoWetting, const Bodies& bodies,
+                                   const std::vector<Collider>& colliders) {
   if (!v.is_object()) {
     log.expected(path, "an object (a cloth piece)", v);
     return std::nullopt;
@@ -331,65 +410,30 @@ std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::stri
   ClothSpec spec;
   spec.path = path;
   spec.name = r.string("name", fmt::format("cloth{}", index));
+  const ClothSolver solver = readClothSolver(r);
   std::optional<RectangleInfo> rect;
-  const std::optional<TriangleMesh> mesh = readMesh(r.object("mesh", true), baseDir, maxVertices, rect);
-  spec.material = readMaterial(r.object("material"));
+  std::optional<TriangleMesh> mesh =
+      readMesh(r.object("mesh", true), baseDir, maxVertices, rect, bodies, spec.panelOfVertex);
+  spec.material = readMaterial(r.object("material"), solver);
   spec.pinned = readPins(r.object("pin"), mesh ? &*mesh : nullptr, rect);
+  spec.chen = readChenCloth(r, solver, shaoWetting);
   r.finish();
   if (!mesh) return std::nullopt;
-  spec.mesh = *mesh;
+  if (spec.chen.bodyMargin < 0.0f) spec.chen.bodyMargin = 0.5f * spec.material.thickness;
+  checkOutsideBody(log, path, spec.chen, bodies, colliders, *mesh);
+  spec.mesh = std::move(*mesh);
   return spec;
 }
 
-// pose: position + rotation, or keyframes; a plane may give its normal instead of a rotation
-std::vector<Keyframe> readPose(ObjectReader& r, bool isPlane) {
-  ErrorLog& log = r.log();
-  const bool hasKeys = r.has("keyframes"), hasPos = r.has("position"), hasRot = r.has("rotation");
-  const bool hasNormal = isPlane && r.has("normal");
-  if (hasKeys && (hasPos || hasRot))
-    log.error(r.pathOf("keyframes"), "expected either position/rotation or keyframes, got both");
-  if (hasNormal && (hasRot || hasKeys))
-    log.error(r.pathOf("normal"), "expected normal alone, got it together with rotation or keyframes");
-  Keyframe still;
-  still.translation = r.vec3("position", Vec3::Zero());
-  still.rotation = readRotation(r.object("rotation"));
-  if (isPlane) {
-    // the rotation taking local +y (the plane's normal) to the given normal
-    const Vec3 normal = r.unitVec3("normal", Vec3::UnitY());
-    if (hasNormal) still.rotation = Quat::FromTwoVectors(Vec3::UnitY(), normal).normalized();
-  }
-  const Json* keys = r.array("keyframes");
-  if (!keys) return {still};
-  if (keys->empty()) {
-    log.expected(r.pathOf("keyframes"), "an array of at least one keyframe", *keys);
-    return {still};
-  }
-  std::vector<Keyframe> out;
-  for (size_t i = 0; i < keys->size(); ++i) {
-    const std::string kp = indexPath(r.pathOf("keyframes"), i);
-    if (!(*keys)[i].is_object()) {
-      log.expected(kp, "an object (a keyframe)", (*keys)[i]);
-      continue;
-    }
-    ObjectReader k(log, &(*keys)[i], kp);
-    Keyframe key;
-    key.time = k.number("time", std::nullopt, Range::nonNegative());
-    key.translation = k.vec3("position", Vec3::Zero());
-    key.rotation = readRotation(k.object("rotation"));
-    k.finish();
-    if (!out.empty() && !(key.time > out.back().time))
-      log.error(k.pathOf("time"), fmt::format("expected a time > the previous keyframe's ({} s), got {}",
-                                              out.back().time, key.time));
-    out.push_back(key);
-  }
-  return out.empty() ? std::vector<Keyframe>{still} : out;
-}
-
-const std::vector<std::string> kColliderTypes = {"plane", "box", "container", "sphere", "capsule"};
+// in ColliderShape order, then the mannequin (many colliders)
+const std::vector<std::string> kColliderTypes = {"plane", "box", "container", "sphere", "capsule", "mesh", "mannequin"};
 // the keys that only some collider types have
-const std::vector<std::string> kColliderShapeKeys = {"normal", "halfExtents", "wallThickness", "radius", "halfHeight"};
+const std::vector<std::string> kColliderShapeKeys = {"normal", "halfExtents", "wallThickness", "radius", "halfHeight",
+                                                     "path",   "resolution",  "padding",       "height", "yaw",
+                                                     "proportions", "pose", "sampleInterval"};
 
-std::optional<Collider> readCollider(ErrorLog& log, const Json& v, const std::string& path, int index) {
+std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, const std::string& path, int index,
+                                                  const std::string& baseDir, Bodies& bodies) {
   if (!v.is_object()) {
     log.expected(path, "an object (a collider)", v);
     return std::nullopt;
@@ -399,6 +443,12 @@ std::optional<Collider> readCollider(ErrorLog& log, const Json& v, const std::st
   c.name = r.string("name", fmt::format("collider{}", index));
   const int type = r.choice("type", kColliderTypes, std::nullopt);
   if (type < 0) return std::nullopt;  // keys depend on the type: nothing more to check
+  if (kColliderTypes[size_t(type)] == "mannequin") {
+    if (bodies.count(c.name)) log.error(r.pathOf("name"), fmt::format("expected a unique name, got \"{}\" twice", c.name));
+    std::vector<Collider> body = readMannequin(r, c.name, bodies);
+    if (body.empty()) return std::nullopt;
+    return body;
+  }
   c.shape = ColliderShape(type);
   const Collider d;
   std::vector<std::string> mine;
@@ -424,6 +474,10 @@ std::optional<Collider> readCollider(ErrorLog& log, const Json& v, const std::st
       c.halfHeight = r.number("halfHeight", d.halfHeight, Range::positive());
       mine = {"radius", "halfHeight"};
       break;
+    case ColliderShape::Mesh:
+      readMeshColliderShape(r, c, baseDir);
+      mine = {"path", "resolution", "padding"};
+      break;
   }
   c.friction = r.number("friction", d.friction, Range::unit());
   c.restitution = r.number("restitution", d.restitution, Range::unit());
@@ -432,11 +486,13 @@ std::optional<Collider> readCollider(ErrorLog& log, const Json& v, const std::st
   for (const auto& k : kColliderShapeKeys)
     if (std::find(mine.begin(), mine.end(), k) == mine.end()) others.push_back(k);
   r.finish(others, "a " + kColliderTypes[size_t(type)] + " collider");
-  return c;
+  if (c.shape == ColliderShape::Mesh && !c.sdf) return std::nullopt;
+  return std::vector<Collider>{c};
 }
 
 const std::vector<std::string> kBlockKeys = {"min", "max", "velocity"};
 const std::vector<std::string> kJetKeys = {"origin", "direction", "speed", "radius", "end"};
+const std::vector<std::string> kRainKeys = {"origin", "halfExtents", "rate", "dropSpeed", "dropRadius", "direction", "end"};
 
 // true also when the domain itself is invalid (that error is reported once, at solver.domain)
 bool insideDomain(const SolverParams& s, const Vec3& p) {
@@ -454,7 +510,7 @@ std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::stri
   Emitter e;
   const Emitter d;
   e.name = r.string("name", fmt::format("emitter{}", index));
-  const int type = r.choice("type", {"block", "jet"}, std::nullopt);
+  const int type = r.choice("type", {"block", "jet", "rain"}, std::nullopt);
   if (type < 0) return std::nullopt;
   e.kind = EmitterKind(type);
   const std::string domain = fmt::format("inside solver.domain ({} to {})", fmtVec(solver.domainMin),
@@ -464,12 +520,17 @@ std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::stri
     e.boxMax = r.vec3("max", std::nullopt);
     e.velocity = r.vec3("velocity", d.velocity);
     e.start = r.number("start", d.start, Range::nonNegative());
-    r.finish(kJetKeys, "a block emitter");
+    r.finish(concat(kJetKeys, kRainKeys), "a block emitter");
     if (r.has("min") && r.has("max") && checkOrdered(log, r.pathOf("max"), "min", e.boxMin, e.boxMax)) {
       if (!insideDomain(solver, e.boxMin) || !insideDomain(solver, e.boxMax))
         log.error(r.path(), fmt::format("expected a block {}, got min {} max {}", domain, fmtVec(e.boxMin),
                                         fmtVec(e.boxMax)));
     }
+  } else if (e.kind == EmitterKind::Rain) {
+    readRain(r, e);
+    r.finish(concat(kBlockKeys, kJetKeys), "a rain emitter");
+    if (r.has("origin") && !insideDomain(solver, e.origin))
+      log.error(r.pathOf("origin"), fmt::format("expected a point {}, got {}", domain, fmtVec(e.origin)));
   } else {
     e.origin = r.vec3("origin", std::nullopt);
     e.direction = r.unitVec3("direction", d.direction);
@@ -477,7 +538,7 @@ std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::stri
     e.radius = r.number("radius", d.radius, Range::positive());
     e.start = r.number("start", d.start, Range::nonNegative());
     e.end = r.number("end", d.end, Range::positive());
-    r.finish(kBlockKeys, "a jet emitter");
+    r.finish(concat(kBlockKeys, kRainKeys), "a jet emitter");
     if (r.has("end") && !(e.end > e.start))
       log.error(r.pathOf("end"), fmt::format("expected a time > start ({} s), got {}", e.start, e.end));
     if (r.has("origin") && !insideDomain(solver, e.origin))
@@ -515,11 +576,13 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   readOutput(top.object("output"), scene.output);
   readWetting(top.object("wetting"), model.wetting);
   const int maxVertices = model.solver.maxParticles;
+  Bodies bodies;  // mannequins by name, for the garments sewn around them
+  for (auto& group : readArray<std::vector<Collider>>(top, "colliders", [&](const Json& v, const std::string& p, int i) {
+         return readCollider(log, v, p, i, baseDir, bodies);
+       }))
+    for (Collider& c : group) model.colliders.push_back(std::move(c));
   const std::vector<ClothSpec> cloth = readArray<ClothSpec>(top, "cloth", [&](const Json& v, const std::string& p, int i) {
-    return readCloth(log, v, p, i, baseDir, maxVertices);
-  });
-  model.colliders = readArray<Collider>(top, "colliders", [&](const Json& v, const std::string& p, int i) {
-    return readCollider(log, v, p, i);
+    return readCloth(log, v, p, i, baseDir, maxVertices, model.wetting.enabled, bodies, model.colliders);
   });
   model.emitters = readArray<Emitter>(top, "emitters", [&](const Json& v, const std::string& p, int i) {
     return readEmitter(log, v, p, i, model.solver);
@@ -538,8 +601,15 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   log.throwIfAny();
 
   // build: topology is checked by addClothPiece (manifold edges, degenerate triangles)
-  for (const ClothSpec& c : cloth)
-    addClothPiece(model, c.name, c.mesh, c.material, c.pinned, fmt::format("{}: at {}.mesh", file, c.path));
+  for (const ClothSpec& c : cloth) {
+    addClothPiece(model, c.name, c.mesh, c.material, c.pinned, fmt::format("{}: at {}.mesh", file, c.path),
+                  c.chen.solver);
+    ClothPiece& piece = model.pieces.back();
+    piece.garment = c.chen.garment;
+    piece.wetByContact = c.chen.wetByContact;
+    piece.dropsVanish = c.chen.dropsVanish;
+    piece.panelOfVertex = c.panelOfVertex;
+  }
   buildTethers(model);
   Particles& p = scene.state.particles;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
@@ -552,6 +622,11 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   }
   scene.state.nextId = uint32_t(model.numCloth);
   scene.state.emitters.resize(model.emitters.size());
+  for (const ClothPiece& piece : model.pieces)
+    if (piece.wetByContact) scene.state.clothWetStart.assign(size_t(model.numCloth), std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < cloth.size(); ++k)
+    if (cloth[k].chen.wetAtStart && model.pieces[k].wetByContact)
+      std::fill_n(scene.state.clothWetStart.begin() + model.pieces[k].firstParticle, model.pieces[k].particleCount, 0.0f);
   if (model.wetting.enabled) {
     const std::vector<float> volume = restVolumes(model, p.radius);
     checkDripThreshold(log, model, volume);

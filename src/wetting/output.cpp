@@ -9,6 +9,11 @@ namespace soak {
 std::vector<Vec3> saturationColors(const Model& model, const State& state, const std::string& ramp) {
   const size_t nc = static_cast<size_t>(model.numCloth);
   if (!model.wetting.enabled || state.clothSaturation.size() != nc) return {};
+  return rampColors(state.clothSaturation, model.wetting.saturationMax, ramp);
+}
+
+std::vector<Vec3> rampColors(const std::vector<float>& value, float valueMax, const std::string& ramp) {
+  const size_t nc = value.size();
   Vec3 dry;
   if (ramp == "red")
     dry = Vec3(1.0f, 0.0f, 0.0f);
@@ -16,10 +21,9 @@ std::vector<Vec3> saturationColors(const Model& model, const State& state, const
     dry = Vec3(0.0f, 1.0f, 0.0f);
   else
     return {};
-  const float sMax = model.wetting.saturationMax;
   std::vector<Vec3> colors(nc);
   for (size_t i = 0; i < nc; ++i) {
-    const float t = sMax > 0.0f ? std::clamp(state.clothSaturation[i] / sMax, 0.0f, 1.0f) : 0.0f;
+    const float t = valueMax > 0.0f ? std::clamp(value[i] / valueMax, 0.0f, 1.0f) : 0.0f;
     colors[i] = (1.0f - t) * dry;
   }
   return colors;

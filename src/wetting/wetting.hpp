@@ -136,5 +136,7 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
 // vertex colours of the cloth by saturation S / S^MAX: "red" fades red to black (Fig. 3), "green" green
 // to black (Fig. 4); empty for "none" or when wetting is off
 std::vector<Vec3> saturationColors(const Model& model, const State& state, const std::string& ramp);
+// the same ramp for any per-vertex value: valueMax is drawn black (fully wet), 0 in the ramp's colour
+std::vector<Vec3> rampColors(const std::vector<float>& value, float valueMax, const std::string& ramp);
 
 }  // namespace soak

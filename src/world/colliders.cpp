@@ -168,7 +168,7 @@ void projectColliders(const Model& model, const std::vector<ColliderPose>& poses
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   if (numColliders == 0) return;
   parallelFor(n, [&](int64_t i) {
-    if (!(p.invMass[i] > 0.0f)) return;
+    if (!(p.invMass[i] > 0.0f) || model.implicitCloth(i)) return;  // implicit cloth: contact in its own solve
     const float margin = contactMargin(model, p.phase[i]);
     Vec3 xp = p.xPred[i];
     for (size_t c = 0; c < numColliders; ++c) {

@@ -103,7 +103,7 @@ struct SleeveFrame {
   float radius = 0.0f, length = 0.0f;
 };
 
-void checkParams(const GarmentParams& g, const std::string& source) {
+void checkParams(const GarmentPattern& g, const std::string& source) {
   const std::string w = "garment";
   if (!(g.edgeLength > 0.0f)) throw errorAt(source, w + ".edgeLength", "must be a positive length in m");
   if (!(g.margin >= 0.0f)) throw errorAt(source, w + ".margin", "must be >= 0 m");
@@ -171,7 +171,7 @@ size_t pushOutOfBody(TriangleMesh& mesh, const std::vector<Collider>& body, doub
   return left;
 }
 
-Garment buildGarment(const MannequinParams& bodyIn, const MannequinPose& pose, const GarmentParams& gp,
+Garment buildGarment(const MannequinParams& bodyIn, const MannequinPose& pose, const GarmentPattern& gp,
                      const std::string& source) {
   checkParams(gp, source);
   const bool tshirt = gp.style == GarmentStyle::TShirt;

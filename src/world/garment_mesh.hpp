@@ -13,7 +13,7 @@ namespace soak {
 
 enum class GarmentStyle { TShirt, Dress };
 
-struct GarmentParams {
+struct GarmentPattern {
   GarmentStyle style = GarmentStyle::TShirt;
   float edgeLength = 0.03f;    // m, target spacing of the panel grids
   float margin = 0.01f;        // m, least distance of every vertex from the body at the start
@@ -40,7 +40,7 @@ struct Garment {
 // body. Every edge is in one or two triangles. Throws soak::Error (naming `source`) when the
 // parameters are out of range or the arms are too close to the body for the style (tshirt: raise
 // shoulderAbduction; 0.7 rad works at default proportions, the dress needs 0.3 rad).
-Garment buildGarment(const MannequinParams& body, const MannequinPose& pose, const GarmentParams& params,
+Garment buildGarment(const MannequinParams& body, const MannequinPose& pose, const GarmentPattern& params,
                      const std::string& source = "garment");
 
 // the union's signed distance (m) at time t, with the nearest collider's outward normal

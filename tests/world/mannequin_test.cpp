@@ -188,7 +188,7 @@ TEST(MannequinBody, RefusesBadParameters) {
 
 // the checks every garment must pass: accepted as cloth, every edge in one or two triangles, panels
 // on every vertex, every vertex outside the body by the margin and most of them near it
-void checkGarment(const Garment& g, const MannequinParams& mp, const GarmentParams& gp, int panels) {
+void checkGarment(const Garment& g, const MannequinParams& mp, const GarmentPattern& gp, int panels) {
   ASSERT_GT(g.mesh.vertices.size(), 200u);
   Model model;
   EXPECT_NO_THROW(addClothPiece(model, "garment", g.mesh, ClothMaterial{}, {}, "garment"));
@@ -224,7 +224,7 @@ TEST(MannequinGarment, TShirtIsManifoldOutsideTheBodyWithFourPanels) {
   mp.yaw = 0.4f;
   const MannequinPose pose = aPose(0.8f);
   mp.pose = pose;
-  GarmentParams gp;
+  GarmentPattern gp;
   const Garment g = buildGarment(mp, pose, gp);
   checkGarment(g, mp, gp, 4);
   // the shirt spans from the hem to above the shoulders
@@ -247,7 +247,7 @@ TEST(MannequinGarment, DressIsManifoldOutsideTheBodyDownToTheKnees) {
   MannequinPose pose = aPose(0.4f);
   pose.kneeFlexion = {0.2f, 0.0f};
   mp.pose = pose;
-  GarmentParams gp;
+  GarmentPattern gp;
   gp.style = GarmentStyle::Dress;
   gp.edgeLength = 0.035f;
   const Garment g = buildGarment(mp, pose, gp);
@@ -262,8 +262,8 @@ TEST(MannequinGarment, DressIsManifoldOutsideTheBodyDownToTheKnees) {
 TEST(MannequinGarment, ArmsAtTheSidesAreRefused) {
   MannequinParams mp;
   const MannequinPose pose;  // arms hanging straight down
-  EXPECT_THROW(buildGarment(mp, pose, GarmentParams{}), Error);
-  GarmentParams bad;
+  EXPECT_THROW(buildGarment(mp, pose, GarmentPattern{}), Error);
+  GarmentPattern bad;
   bad.edgeLength = -0.01f;
   EXPECT_THROW(buildGarment(mp, aPose(0.8f), bad), Error);
 }

@@ -1,0 +1,55 @@
+// the Chen 2012 garment stages of the step (docs/garment.md, "Calls from the step"): the implicit
+// solve of every piece with "solver": "implicit", the saturation mass of Eq. 15-19 for any piece
+// that asks for it, and the wet signal (the time each cloth vertex first got wet) that the
+// saturation mass, the wet friction of Fig. 5 and the wrinkle disturbances read.
+#pragma once
+#include <soak/model.hpp>
+#include <soak/state.hpp>
+#include <soak/stats.hpp>
+
+#include "garment/implicit.hpp"
+#include "grid/grid.hpp"
+#include "world/colliders.hpp"
+
+#include <vector>
+
+namespace soak {
+
+struct GarmentScratch {
+  bool built = false;
+  std::vector<int> slot;                 // per cloth piece: index into pieces / scratch, -1 for a PBD piece
+  std::vector<GarmentPiece> pieces;      // springs and system pattern of each implicit piece, built once
+  std::vector<ImplicitScratch> scratch;
+  std::vector<Vec3> solved;              // xPred of the implicit cloth particles right after their solve
+  std::vector<int32_t> touch;            // per particle: the cloth vertex a water particle wets, or -1
+};
+
+// before the PBD stages, after predictPositions (which skips implicit cloth): sets the Eq. 15-19 mass
+// of every piece with garment.saturationMass, then runs garmentSubstep (Eq. 1-5, wrinkles, contact
+// with wet friction) for every implicit piece, writing its xPred and v. poses are the colliders at
+// state.time + h.
+void solveGarments(const Model& model, State& state, GarmentScratch& s, const std::vector<ColliderPose>& poses,
+                   float h, StepStats& stats);
+
+// after the water coupling (Eq. 21), which may have moved implicit cloth: adds that displacement over
+// h to its velocity (updateVelocities skips implicit cloth)
+void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch& s, float h);
+
+// after commitPositions: records the first wet time of the vertices of pieces with wetByContact.
+// With Shao's wetting on, a vertex is wet once it holds water (State::clothWater > 0). Without it, a
+// vertex is wet when a water particle comes within touchDistance(piece) of it (a particle wets every
+// vertex within its reach); the particle then vanishes into the cloth when the piece of the nearest
+// vertex it touches has dropsVanish (counted in WaterLedger::takenByCloth).
+// time is the end of the substep. Returns the number of water particles taken.
+size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,
+                         std::vector<uint8_t>& keep, double time);
+
+// per cloth particle, how wet it is in [0, 1]: Q(t) / delta (Eq. 18) for the pieces with wetByContact,
+// 0 elsewhere and for dry vertices (the "wetness" attribute of the cloth PLY)
+std::vector<float> clothWetness(const Model& model, const State& state);
+
+// the distance within which a water particle wets a cloth vertex: the piece's thickness (the
+// distance Eq. 21 keeps water from a triangle) plus one water spacing (m)
+float touchDistance(const Model& model, const ClothPiece& piece);
+
+}  // namespace soak
