@@ -55,6 +55,7 @@ struct WrinkleParams {
   int patchSize = 100;                 // vertices per subdomain when the garment has no panels
   float tieTolerance = 1e-3f;          // |AA1| = |AA2| when they differ by less than this fraction of l0 (step 5)
   uint32_t seed = 1;                   // the paper's random choice between equal candidates, made reproducible
+  float strength = 1.0f;               // fraction of the way from A to the chosen point A' the vertex is moved, (0, 1]
 };
 
 // everything the implicit garment solver of one cloth piece reads (implicit.hpp)

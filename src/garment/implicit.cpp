@@ -53,6 +53,8 @@ void checkGarmentParams(const GarmentParams& p, const std::string& where) {
           p.wrinkles.equilibriumSpeed);
   require(p.wrinkles.tieTolerance >= 0.0f, where, "wrinkles.tieTolerance", "a number >= 0", p.wrinkles.tieTolerance);
   require(p.wrinkles.interval >= 1, where, "wrinkles.interval", "an integer >= 1", p.wrinkles.interval);
+  require(p.wrinkles.strength > 0.0f && p.wrinkles.strength <= 1.0f, where, "wrinkles.strength", "a number in (0, 1]",
+          p.wrinkles.strength);
   require(p.wrinkles.patchSize >= 3, where, "wrinkles.patchSize", "an integer >= 3", p.wrinkles.patchSize);
 }
 
@@ -172,9 +174,8 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     }
     Vec3 vel = (p.v[i].cast<double>() + w.dv[v]).cast<float>();
     Vec3 x = p.x[i] + h * vel;
-    if (w.constrained[v] == 2) {  // disturbed: reaches its target exactly
+    if (w.constrained[v] == 2) {  // disturbed: reaches its target exactly, keeps its velocity (departure 14)
       p.xPred[i] = x;
-      p.v[i] = vel;
       return;
     }
     const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;

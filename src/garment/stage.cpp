@@ -94,7 +94,12 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
   if (s.solved.size() < static_cast<size_t>(model.numCloth)) return;
   const float inv = 1.0f / h;
   parallelFor(model.numCloth, [&](int64_t i) {
-    if (model.implicitCloth(i)) p.v[i] += (p.xPred[i] - s.solved[size_t(i)]) * inv;
+    if (!model.implicitCloth(i)) return;
+    if (!model.wetting.enabled && model.pieces[size_t(clothPiece(p.phase[i]))].dropsVanish) {
+      p.xPred[i] = s.solved[size_t(i)];  // drops vanish into it: they do not push it (docs/models.md)
+      return;
+    }
+    p.v[i] += (p.xPred[i] - s.solved[size_t(i)]) * inv;
   });
 }
 

@@ -32,7 +32,8 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
                    float h, StepStats& stats);
 
 // after the water coupling (Eq. 21), which may have moved implicit cloth: adds that displacement over
-// h to its velocity (updateVelocities skips implicit cloth)
+// h to its velocity (updateVelocities skips implicit cloth). A piece whose drops vanish (no Shao
+// wetting) is not moved by the water: the displacement is undone (one-way coupling)
 void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch& s, float h);
 
 // after commitPositions: records the first wet time of the vertices of pieces with wetByContact.

@@ -180,7 +180,9 @@ std::vector<PositionConstraint> computeDisturbances(const Model& model, int piec
     const int coin = static_cast<int>(splitmix(splitmix(params.seed ^ (uint64_t(piece) << 32)) ^ (uint64_t(a) << 20) ^
                                                stepIndex) & 1u);
     const int pick = chooseDisturbance(pos(a), hits, collides, pos(b), pos(d), params.tieTolerance * l0ab, coin);
-    if (pick >= 0) out.push_back({a, hits.point[pick]});
+    // an imperfection is small: a target further than one rest length from A is not used (departure 14)
+    if (pick >= 0 && (hits.point[pick] - pos(a)).norm() <= l0ab)
+      out.push_back({a, pos(a) + params.strength * (hits.point[pick] - pos(a))});
   }
   return out;
 }

@@ -106,6 +106,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.wrinkles.interval = w.integer("interval", d.wrinkles.interval, Range::atLeast(1));
   g.wrinkles.patchSize = w.integer("patchSize", d.wrinkles.patchSize, Range::atLeast(3));
   g.wrinkles.tieTolerance = w.number("tieTolerance", d.wrinkles.tieTolerance, Range::nonNegative());
+  g.wrinkles.strength = w.number("strength", d.wrinkles.strength, Range{0.0, 1.0, true, false});
   g.wrinkles.seed = static_cast<uint32_t>(w.integer("seed", int(d.wrinkles.seed), Range::atLeast(0)));
   w.finish();
   r.finish();
