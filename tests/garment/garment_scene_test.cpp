@@ -10,9 +10,11 @@
 #include "garment/saturation_mass.hpp"
 #include "garment/stage.hpp"
 #include "io/stats.hpp"
+#include "world/colliders.hpp"
 #include "world/garment_mesh.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -166,6 +168,30 @@ TEST(GarmentSceneErrors, ClothStartingInsideTheBodyIsPushedOutOrRefusedNamingVer
     moved += x.y() > 1.0f + 1e-5f ? 1 : 0;
   }
   EXPECT_GT(moved, 0);
+}
+
+TEST(GarmentScene, MeshColliderFromAnObjFile) {
+  // a closed unit cube, outward winding
+  const std::string dir = ::testing::TempDir();
+  const std::string obj = dir + "/soak_cube_collider.obj";
+  std::ofstream(obj) << "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n"
+                        "v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n"
+                        "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+                        "f 4 8 7\nf 4 7 3\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\n";
+  const std::string scene = R"({"colliders": [{"name": "rock", "type": "mesh", "path": ")" + obj +
+                            R"(", "resolution": 0.05, "position": [0, 1, 0]}],
+    "emitters": [{"type": "block", "min": [-0.1, 2, -0.1], "max": [0.1, 2.2, 0.1]}]})";
+  const Scene s = fromString(scene);
+  ASSERT_EQ(s.model.colliders.size(), 1u);
+  const Collider& c = s.model.colliders[0];
+  EXPECT_EQ(c.shape, ColliderShape::Mesh);
+  ASSERT_TRUE(c.sdf != nullptr);
+  // the cube's top face is at y = 1.5 in the world
+  EXPECT_NEAR(colliderDistance(c, colliderPose(c, 0.0), Vec3(0, 1.7f, 0), nullptr), 0.2f, 0.02f);
+  EXPECT_LT(colliderDistance(c, colliderPose(c, 0.0), Vec3(0, 1.0f, 0), nullptr), 0.0f);
+  EXPECT_HAS(loadError(scene, {"colliders.0.path=nowhere.obj"}),
+             "at colliders[0].path: expected the path of an existing OBJ file, got \"nowhere.obj\"");
+  EXPECT_HAS(loadError(scene, {"colliders.0.radius=1"}), "'radius' is not a key of a mesh collider");
 }
 
 TEST(GarmentRun, RainWetsTheGarmentByQAndEveryDropIsAccounted) {
