@@ -107,6 +107,32 @@ TEST(GarmentScene, KeysReachTheModel) {
     EXPECT_GE(bodyDistance(body, 0.0, s.state.particles.x[size_t(i)], nullptr), 0.0099f) << i;
 }
 
+TEST(GarmentScene, MannequinPoseKeyframesAnimateItsColliders) {
+  const Scene s = fromString(R"({
+    "colliders": [{"name": "body", "type": "mannequin",
+                   "keyframes": [{"time": 0, "pose": {"shoulderAbduction": [45, 45]}},
+                                 {"time": 1, "pose": {"shoulderAbduction": [45, 45], "elbowFlexion": [90, 0]}}]}],
+    "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [0.5, 0.5]}]})");
+  const std::vector<Collider>& c = s.model.colliders;
+  const auto find = [&](const std::string& name) -> const Collider& {
+    for (const Collider& x : c)
+      if (x.name == name) return x;
+    throw Error("no collider " + name);
+  };
+  const Collider& left = find("body.hand_l");
+  const Collider& right = find("body.hand_r");
+  EXPECT_GT(left.keys.size(), 20u);  // sampled every 1/30 s
+  const Vec3 l0 = colliderPose(left, 0.0).translation, l1 = colliderPose(left, 1.0).translation;
+  const Vec3 r0 = colliderPose(right, 0.0).translation, r1 = colliderPose(right, 1.0).translation;
+  EXPECT_GT((l1 - l0).norm(), 0.1f);   // the bent left elbow brings the hand forward
+  EXPECT_GT(l1.z(), l0.z() + 0.1f);
+  EXPECT_LT((r1 - r0).norm(), 1e-4f);  // the right arm keeps its pose
+  EXPECT_HAS(loadError(R"({"colliders": [{"name": "b", "type": "mannequin", "pose": {},
+                                          "keyframes": [{"time": 0, "pose": {}}]}],
+                           "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [1, 1]}]})"),
+             "at colliders[0].keyframes: expected either pose or keyframes, got both");
+}
+
 TEST(GarmentSceneErrors, UnknownFabricListsTheKnownOnes) {
   EXPECT_HAS(loadError(kSheet, {"cloth.0.fabric=denim"}),
              "garment.json: at cloth[0].fabric: expected one of \"cotton\", \"coarse_wool\", \"high_absorption\", "
