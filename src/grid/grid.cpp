@@ -2,6 +2,8 @@
 
 #include "core/parallel.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 
 namespace soak {
@@ -28,32 +30,180 @@ void buildGrid(const std::vector<Vec3>& x, float cellSize, NeighborGrid& grid) {
   grid.cellStart[0] = 0;
 }
 
+namespace {
+
+// the candidate ranges of the last cell looked up: particles in the same cell share them, and
+// consecutive particles (cloth rows, water sorted by cell) are mostly in the same cell. Each range
+// keeps the offset of its cell, so a particle skips the cells its reach does not touch (a bucket
+// shared by two cells gets offset 0 and is never skipped).
+struct RangeCache {
+  Eigen::Vector3i cell{0, 0, 0};
+  bool valid = false;
+  int count = 0;
+  uint32_t ranges[27][2];
+  uint32_t buckets[27];
+  int8_t offset[27][3];
+  void lookup(const NeighborGrid& grid, const Eigen::Vector3i& c) {
+    if (valid && c == cell) return;
+    count = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const uint32_t b = grid.bucketOf(c + Eigen::Vector3i(dx, dy, dz));
+          if (grid.cellStart[b] == grid.cellStart[b + 1]) continue;
+          int dup = -1;
+          for (int s = 0; s < count; ++s)
+            if (buckets[s] == b) dup = s;
+          if (dup >= 0) {
+            offset[dup][0] = offset[dup][1] = offset[dup][2] = 0;
+            continue;
+          }
+          buckets[count] = b;
+          ranges[count][0] = grid.cellStart[b];
+          ranges[count][1] = grid.cellStart[b + 1];
+          offset[count][0] = static_cast<int8_t>(dx);
+          offset[count][1] = static_cast<int8_t>(dy);
+          offset[count][2] = static_cast<int8_t>(dz);
+          ++count;
+        }
+    cell = c;
+    valid = true;
+  }
+  // whether the range r can hold a particle within reach of x (f: x's place inside its cell, 0..cellSize)
+  static bool touches(const int8_t* o, const float* f, float cellSize, float reach2) {
+    float d2 = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+      const float d = o[a] < 0 ? f[a] : (o[a] > 0 ? cellSize - f[a] : 0.0f);
+      d2 += d * d;
+    }
+    return d2 < reach2;
+  }
+};
+
+}  // namespace
+
 void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
-                        NeighborLists& lists) {
+                        NeighborLists& lists, uint32_t firstWater) {
   const size_t n = x.size();
+  lists.firstWater = firstWater;
   lists.start.resize(n + 1);
+  lists.mid.resize(n);
+  lists.packed.resize(n);
   lists.start[0] = 0;
-  auto visit = [&](size_t i, auto&& emit) {
-    const Vec3 xi = x[i];
-    const float hi = radius[i];
-    grid.forEachCandidate(xi, [&](uint32_t j) {
-      if (j == i) return;
-      const float h = 0.5f * (hi + radius[j]);
-      if ((xi - x[j]).squaredNorm() < h * h) emit(j);
-    });
+  using Packed = NeighborLists::Packed;
+  Packed* packed = lists.packed.data();
+  const uint32_t* entries = grid.cellEntries.data();
+  const float cs = grid.cellSize;
+  const bool parallel = static_cast<int64_t>(n) >= kParallelGrain;
+  // candidates read their position and radius from one contiguous array in bucket order
+  parallelFor(static_cast<int64_t>(n), [&](int64_t k) {
+    const uint32_t j = entries[k];
+    packed[k] = {x[j].x(), x[j].y(), x[j].z(), radius[j]};
+  });
+
+  // the neighbours of i, cloth ones to cl[0 .. nCloth) and water ones to wa[0 .. nWater), in a
+  // fixed order. Branch free: every candidate is written, the cursor advances only for neighbours.
+  // Cells the particle's reach does not touch are skipped.
+  const auto gather = [&](size_t i, RangeCache& cache, std::vector<uint32_t>& cl, std::vector<uint32_t>& wa,
+                          uint32_t& nCloth, uint32_t& nWater) {
+    const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
+    const Eigen::Vector3i c = grid.cellOf(x[i]);
+    cache.lookup(grid, c);
+    const float f[3] = {xi - cs * c.x(), yi - cs * c.y(), zi - cs * c.z()};
+    const float reach = 0.5f * (hi + cs) * 1.001f, reach2 = reach * reach;  // margin for rounding
+    uint32_t ncl = 0, nwa = 0;
+    for (int r = 0; r < cache.count; ++r) {
+      if (!RangeCache::touches(cache.offset[r], f, cs, reach2)) continue;
+      const uint32_t k0 = cache.ranges[r][0], k1 = cache.ranges[r][1];
+      if (ncl + (k1 - k0) > cl.size()) cl.resize(2 * (ncl + (k1 - k0)));
+      if (nwa + (k1 - k0) > wa.size()) wa.resize(2 * (nwa + (k1 - k0)));
+      uint32_t* pc = cl.data();
+      uint32_t* pw = wa.data();
+      for (uint32_t k = k0; k < k1; ++k) {
+        const Packed q = packed[k];
+        const float dx = xi - q.x, dy = yi - q.y, dz = zi - q.z;
+        const float h = 0.5f * (hi + q.h);
+        const uint32_t j = entries[k];
+        const uint32_t in = (dx * dx + dy * dy + dz * dz < h * h) & (j != static_cast<uint32_t>(i));
+        const uint32_t isCloth = j < firstWater;
+        pc[ncl] = j;
+        pw[nwa] = j;
+        ncl += in & isCloth;
+        nwa += in & (isCloth ^ 1u);
+      }
+    }
+    nCloth = ncl;
+    nWater = nwa;
   };
-  // pass 1 counts, pass 2 fills: two distance passes cost less memory than per-thread buffers
-  parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
-    uint32_t c = 0;
-    visit(static_cast<size_t>(i), [&](uint32_t) { ++c; });
-    lists.start[i + 1] = c;
-  });
-  for (size_t i = 0; i < n; ++i) lists.start[i + 1] += lists.start[i];
-  lists.index.resize(lists.start[n]);
-  parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
-    uint32_t w = lists.start[i];
-    visit(static_cast<size_t>(i), [&](uint32_t j) { lists.index[w++] = j; });
-  });
+
+  // room for the lists: last build's total and an eighth (exact on the first build, from a count
+  // pass), so the index array is not reallocated while it is filled
+  const size_t last = lists.index.size();
+  lists.index.clear();
+  if (last > 0) {
+    lists.index.reserve(last + last / 8);
+  } else {
+    size_t total = 0;
+#pragma omp parallel if (parallel) reduction(+ : total)
+    {
+      RangeCache cache;
+      std::vector<uint32_t> cl(256), wa(256);
+#pragma omp for schedule(static)
+      for (int64_t i = 0; i < static_cast<int64_t>(n); ++i) {
+        uint32_t ncl, nwa;
+        gather(static_cast<size_t>(i), cache, cl, wa, ncl, nwa);
+        total += ncl + nwa;
+      }
+    }
+    lists.index.reserve(total + total / 8);
+  }
+
+  // one distance pass, block by block: the threads split a block of particles in contiguous
+  // ranges, gather into their own buffers, then copy to the list in particle order. The lists do
+  // not depend on the thread count; the buffers hold one block, not a copy of the lists.
+  constexpr size_t kBlock = 8192;
+  uint32_t* start = lists.start.data();
+  uint32_t* mid = lists.mid.data();
+  std::vector<size_t> offset(static_cast<size_t>(parallel ? omp_get_max_threads() : 1) + 1, 0);
+#pragma omp parallel if (parallel)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    RangeCache cache;
+    std::vector<uint32_t> cl(256), wa(256), out;
+    for (size_t b0 = 0; b0 < n; b0 += kBlock) {
+      const size_t b1 = std::min(n, b0 + kBlock);
+      const size_t lo = b0 + (b1 - b0) * static_cast<size_t>(t) / static_cast<size_t>(nt);
+      const size_t hi = b0 + (b1 - b0) * static_cast<size_t>(t + 1) / static_cast<size_t>(nt);
+      out.clear();
+      for (size_t i = lo; i < hi; ++i) {
+        uint32_t ncl, nwa;
+        gather(i, cache, cl, wa, ncl, nwa);
+        start[i + 1] = ncl + nwa;  // a count until the offsets are known
+        mid[i] = ncl;
+        out.insert(out.end(), cl.data(), cl.data() + ncl);
+        out.insert(out.end(), wa.data(), wa.data() + nwa);
+      }
+      offset[static_cast<size_t>(t) + 1] = out.size();
+#pragma omp barrier
+#pragma omp single
+      {
+        offset[0] = start[b0];
+        for (int u = 0; u < nt; ++u) offset[static_cast<size_t>(u) + 1] += offset[static_cast<size_t>(u)];
+        const size_t total = offset[static_cast<size_t>(nt)];
+        if (total > lists.index.capacity()) lists.index.reserve(total + total / 4);  // neighbours grew
+        lists.index.resize(total);
+      }
+      std::copy(out.begin(), out.end(), lists.index.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(t)]));
+      size_t s = offset[static_cast<size_t>(t)];
+      for (size_t i = lo; i < hi; ++i) {
+        const uint32_t c = start[i + 1];
+        mid[i] = static_cast<uint32_t>(s) + mid[i];
+        s += c;
+        start[i + 1] = static_cast<uint32_t>(s);
+      }
+#pragma omp barrier
+    }
+  }
 }
 
 }  // namespace soak

@@ -27,13 +27,12 @@ struct NeighborGrid {
     return h & tableMask;
   }
 
-  // calls f(j) once for every particle j in the 27 cells around p (a superset of those within
-  // cellSize of p), in a fixed order; buckets shared by two cells are visited once
-  template <class F>
-  void forEachCandidate(const Vec3& p, F&& f) const {
-    const Eigen::Vector3i c = cellOf(p);
+  // the non-empty buckets of the 27 cells around cell c (a superset of the particles within cellSize
+  // of any point of c) as ranges [begin, end) of cellEntries, in a fixed order, each bucket once even
+  // when two cells share it; returns the number of ranges (at most 27)
+  int candidateRanges(const Eigen::Vector3i& c, uint32_t (*ranges)[2]) const {
     uint32_t seen[27];
-    int nSeen = 0;
+    int nSeen = 0, nRanges = 0;
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
@@ -42,24 +41,51 @@ struct NeighborGrid {
           for (int s = 0; s < nSeen; ++s) dup |= (seen[s] == b);
           if (dup) continue;
           seen[nSeen++] = b;
-          for (uint32_t k = cellStart[b]; k < cellStart[b + 1]; ++k) f(cellEntries[k]);
+          if (cellStart[b] == cellStart[b + 1]) continue;
+          ranges[nRanges][0] = cellStart[b];
+          ranges[nRanges][1] = cellStart[b + 1];
+          ++nRanges;
         }
+    return nRanges;
+  }
+
+  // calls f(j) once for every particle j in the 27 cells around p (a superset of those within
+  // cellSize of p), in a fixed order; buckets shared by two cells are visited once
+  template <class F>
+  void forEachCandidate(const Vec3& p, F&& f) const {
+    uint32_t ranges[27][2];
+    const int nr = candidateRanges(cellOf(p), ranges);
+    for (int r = 0; r < nr; ++r)
+      for (uint32_t k = ranges[r][0]; k < ranges[r][1]; ++k) f(cellEntries[k]);
   }
 };
 
 // neighbour lists, kept through the solver iterations of a step: neighbours of i are
-// index[start[i] .. start[i + 1]), excluding i itself, in a fixed order
+// index[start[i] .. start[i + 1]), excluding i itself, in a fixed order. Those with an index below
+// firstWater (the cloth particles) come first, in [start[i], mid[i]); the others follow in
+// [mid[i], start[i + 1]), so a loop over one kind skips the other.
 struct NeighborLists {
   std::vector<uint32_t> start;
   std::vector<uint32_t> index;
+  std::vector<uint32_t> mid;
+  uint32_t firstWater = 0;              // the index split the lists were built with
+  struct Packed {                       // a particle's position and radius, in cellEntries order
+    float x, y, z, h;
+  };
+  std::vector<Packed> packed;           // scratch of the build: candidates read contiguously
   uint32_t count(size_t i) const { return start[i + 1] - start[i]; }
+  // the cloth neighbours of i when the lists were built with firstWater = numCloth, else all
+  uint32_t clothEnd(size_t i, uint32_t numCloth) const { return firstWater == numCloth ? mid[i] : start[i + 1]; }
+  // the first water neighbour of i when the lists were built with firstWater = numCloth, else the first
+  uint32_t waterBegin(size_t i, uint32_t numCloth) const { return firstWater == numCloth ? mid[i] : start[i]; }
 };
 
 // fills the grid for positions x with the given cell size (counting sort, deterministic)
 void buildGrid(const std::vector<Vec3>& x, float cellSize, NeighborGrid& grid);
 
-// neighbour lists for every particle from a grid built on the same positions
+// neighbour lists for every particle from a grid built on the same positions; in each list the
+// neighbours with index < firstWater (cloth) come before the others (water)
 void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
-                        NeighborLists& lists);
+                        NeighborLists& lists, uint32_t firstWater = 0);
 
 }  // namespace soak

@@ -7,6 +7,8 @@
 
 #include "core/parallel.hpp"
 
+#include <omp.h>
+
 namespace soak {
 
 // C(x1, x2) = |x1 - x2| - l0 (Eq. 8); grad1 = (x1 - x2)/|x1 - x2| = -grad2
@@ -93,27 +95,41 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   float* stretchLambda = scratch.stretchLambda.data();
   float* bendLambda = scratch.bendLambda.data();
 
+  // one parallel region for every colour of every iteration: a barrier between colours (the implicit
+  // one of each omp for) instead of a fork and join; colours below the grain run on one thread
+  const auto stretchColour = [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) {
+      const auto& ids = st.ids[k];
+      Vec3 grad[2];
+      const float C = stretchConstraint(x[ids[0]], x[ids[1]], st.restLength[k], grad[0], grad[1]);
+      xpbdUpdate(ids, C, grad, st.compliance[k] * invDt2, stretchLambda[k], x, w);
+    }
+  };
+  const auto bendColour = [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) {
+      const auto& ids = bd.ids[k];
+      Vec3 grad[4];
+      const float C = bendConstraint(x[ids[0]], x[ids[1]], x[ids[2]], x[ids[3]], bd.restAngle[k], grad);
+      xpbdUpdate(ids, C, grad, bd.compliance[k] * invDt2, bendLambda[k], x, w);
+    }
+  };
+  // each colour split in contiguous chunks, one per thread; a chunk's constraints share no particle
+  // with another's, so the split does not change the result
+  const auto solveColour = [&](const auto& colour, int begin, int end) {
+    if (end - begin < kParallelGrain) {
+#pragma omp single
+      colour(begin, end);
+    } else {
+      const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+      const int64_t len = end - begin;
+      colour(begin + static_cast<int>(len * t / nt), begin + static_cast<int>(len * (t + 1) / nt));
+#pragma omp barrier
+    }
+  };
+#pragma omp parallel
   for (int it = 0; it < iterations; ++it) {
-    for (size_t c = 0; c + 1 < st.colorStart.size(); ++c) {
-      const int begin = st.colorStart[c];
-      parallelFor(st.colorStart[c + 1] - begin, [&](int64_t i) {
-        const size_t k = static_cast<size_t>(begin + i);
-        const auto& ids = st.ids[k];
-        Vec3 grad[2];
-        const float C = stretchConstraint(x[ids[0]], x[ids[1]], st.restLength[k], grad[0], grad[1]);
-        xpbdUpdate(ids, C, grad, st.compliance[k] * invDt2, stretchLambda[k], x, w);
-      });
-    }
-    for (size_t c = 0; c + 1 < bd.colorStart.size(); ++c) {
-      const int begin = bd.colorStart[c];
-      parallelFor(bd.colorStart[c + 1] - begin, [&](int64_t i) {
-        const size_t k = static_cast<size_t>(begin + i);
-        const auto& ids = bd.ids[k];
-        Vec3 grad[4];
-        const float C = bendConstraint(x[ids[0]], x[ids[1]], x[ids[2]], x[ids[3]], bd.restAngle[k], grad);
-        xpbdUpdate(ids, C, grad, bd.compliance[k] * invDt2, bendLambda[k], x, w);
-      });
-    }
+    for (size_t c = 0; c + 1 < st.colorStart.size(); ++c) solveColour(stretchColour, st.colorStart[c], st.colorStart[c + 1]);
+    for (size_t c = 0; c + 1 < bd.colorStart.size(); ++c) solveColour(bendColour, bd.colorStart[c], bd.colorStart[c + 1]);
   }
 }
 
@@ -142,7 +158,7 @@ void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& n
     const auto ringEnd = model.vertexNeighbors.begin() + model.vertexNeighborStart[i + 1];
     Vec3 sum = Vec3::Zero();
     int contacts = 0;
-    for (uint32_t s = neighbors.start[i]; s < neighbors.start[i + 1]; ++s) {
+    for (uint32_t s = neighbors.start[i], end = neighbors.clothEnd(i, static_cast<uint32_t>(n)); s < end; ++s) {
       const int j = static_cast<int>(neighbors.index[s]);
       if (j >= n || j == i || p.phase[j] != p.phase[i]) continue;
       const float wSum = w[i] + w[j];

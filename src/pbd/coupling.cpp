@@ -96,7 +96,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb
       const Vec3 xq0 = p.x[q];
       Vec3 dq = Vec3::Zero();
       // candidate triangles: those around the cloth particles in q's neighbourhood, each once
-      for (uint32_t k = nb.start[q]; k < nb.start[q + 1]; ++k) {
+      for (uint32_t k = nb.start[q], kEnd = nb.clothEnd(q, static_cast<uint32_t>(nc)); k < kEnd; ++k) {
         const uint32_t j = nb.index[k];
         if (static_cast<int64_t>(j) >= nc) continue;
         for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e) {

@@ -17,10 +17,12 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
   parallelFor(nc, [&](int64_t b) {
     const float hb = p.radius[b];
     float sum = poly6(0.0f, hb);  // k includes b itself (NOTES.md on Eq. 10)
-    for (uint32_t k = nb.start[b]; k < nb.start[b + 1]; ++k) {
+    KernelCache kernel;
+    for (uint32_t k = nb.start[b], end = nb.clothEnd(b, static_cast<uint32_t>(nc)); k < end; ++k) {
       const uint32_t j = nb.index[k];
       if (p.phase[j] != p.phase[b]) continue;
-      sum += poly6((p.xPred[b] - p.xPred[j]).squaredNorm(), pairRadius(hb, p.radius[j]));
+      kernel.set(pairRadius(hb, p.radius[j]));
+      sum += kernel.poly6((p.xPred[b] - p.xPred[j]).squaredNorm());
     }
     s.psi[b] = rho0 / sum;  // Psi_b = rho0 V_b, V_b = 1 / sum_k W_bk (Akinci et al. 2012)
   });
@@ -28,11 +30,14 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
 
 namespace {
 
-// artificial pressure s_corr = -k (W_ij / W(dq))^n (Macklin 2013 Eq. 13), in lambda units
+// artificial pressure s_corr = -k (W_ij / W(dq))^n (Macklin 2013 Eq. 13), in lambda units. With
+// dq = c h, W_ij / W(dq) = ((h^2 - r^2) / (h^2 (1 - c^2)))^3: one division, no h^9
 float tensileCorrection(const WaterParams& w, float r2, float h, float scale) {
   if (w.tensileK <= 0.0f) return 0.0f;
-  const float dq = w.tensileDq * h;
-  const float ratio = poly6(r2, h) / poly6(dq * dq, h);
+  const float h2 = h * h;
+  if (r2 >= h2) return 0.0f;
+  const float q = (h2 - r2) / (h2 * (1.0f - w.tensileDq * w.tensileDq));
+  const float ratio = q * q * q;
   float power = 1.0f;
   for (int k = 0; k < w.tensileN; ++k) power *= ratio;
   return -w.tensileK * power * scale;
@@ -65,7 +70,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const int64_t nc = model.numCloth;
   const int64_t nw = static_cast<int64_t>(n) - nc;
   if (nw <= 0) return;
-  const float rho0 = wp.restDensity;
+  const float rho0 = wp.restDensity, invRho0 = 1.0f / rho0;
   s.density.resize(n);
   s.lambda.resize(n);
   s.delta.resize(n);
@@ -82,13 +87,14 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       float rho = mi * poly6(0.0f, hi);
       Vec3 gradI = Vec3::Zero();
       float sumOthers = 0.0f;  // sum over neighbours of w_k |grad_k C|^2
+      KernelCache kernel;
       for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
         const uint32_t j = nb.index[k];
         const Vec3 r = xi - p.xPred[j];
-        const float h = pairRadius(hi, p.radius[j]);
+        kernel.set(pairRadius(hi, p.radius[j]));
         const float mj = isWater(p.phase[j]) ? p.mass[j] : s.psi[j];  // cloth: boundary mass Psi_b
-        rho += mj * poly6(r.squaredNorm(), h);
-        const Vec3 g = (mj / rho0) * spikyGrad(r, h);
+        rho += mj * kernel.poly6(r.squaredNorm());
+        const Vec3 g = (mj * invRho0) * kernel.spikyGrad(r);
         gradI += g;
         sumOthers += p.invMass[j] * g.squaredNorm();
       }
@@ -96,6 +102,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       Vec3 gradWall;
       rho += rho0 * boundaryFraction(s.parts, xi, hi, &gradWall);
       gradI += gradWall;
+      s.delta[i] = gradWall;  // kept for the corrections below (same positions): one wall query per iteration
       s.density[i] = rho;
       // inequality: only compressed water pushes, so a free surface does not clump (departure from
       // Macklin 2013, which also pulls; see docs/models.md)
@@ -109,19 +116,20 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       const Vec3 xi = p.xPred[i];
       const float hi = p.radius[i], li = s.lambda[i];
       Vec3 dx = Vec3::Zero();
+      KernelCache kernel;
       for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
         const uint32_t j = nb.index[k];
         const Vec3 r = xi - p.xPred[j];
         const float h = pairRadius(hi, p.radius[j]);
+        kernel.set(h);
         if (isWater(p.phase[j])) {
           const float sc = tensileCorrection(wp, r.squaredNorm(), h, sCorrScale);
-          dx += p.mass[j] * (li + s.lambda[j] + sc) * spikyGrad(r, h);
+          dx += p.mass[j] * (li + s.lambda[j] + sc) * kernel.spikyGrad(r);
         } else {
-          dx += s.psi[j] * li * spikyGrad(r, h);
+          dx += s.psi[j] * li * kernel.spikyGrad(r);
         }
       }
-      Vec3 gradWall;
-      if (boundaryFraction(s.parts, xi, hi, &gradWall) > 0.0f) dx += rho0 * li * gradWall;
+      dx += rho0 * li * s.delta[i];  // the wall gradient of the lambda pass (zero away from walls)
       s.delta[i] = dx / rho0;
     });
     // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
@@ -130,11 +138,13 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       if (p.invMass[b] == 0.0f) return;
       Vec3 dx = Vec3::Zero();
       int pushing = 0;
-      for (uint32_t k = nb.start[b]; k < nb.start[b + 1]; ++k) {
+      KernelCache kernel;
+      for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1]; ++k) {
         const uint32_t i = nb.index[k];
         if (!isWater(p.phase[i]) || s.lambda[i] == 0.0f) continue;
         const Vec3 r = p.xPred[i] - p.xPred[b];
-        dx -= p.mass[i] * s.lambda[i] * spikyGrad(r, pairRadius(p.radius[i], p.radius[b]));
+        kernel.set(pairRadius(p.radius[i], p.radius[b]));
+        dx -= p.mass[i] * s.lambda[i] * kernel.spikyGrad(r);
         ++pushing;
       }
       // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
@@ -153,43 +163,47 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   const int64_t nc = model.numCloth;
   const int64_t nw = static_cast<int64_t>(n) - nc;
   if (nw <= 0 || (wp.viscosity <= 0.0f && wp.vorticity <= 0.0f)) return;
-  s.vNew.resize(n);
+  std::vector<Vec3>& vNew = s.delta;  // the solver's corrections are spent: reuse their memory
+  vNew.resize(n);
   s.vorticity.resize(n);
   // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), and XSPH (Eq. 17) weighted by V_ij
   parallelFor(nw, [&](int64_t w) {
     const size_t i = static_cast<size_t>(nc + w);
     const Vec3 vi = p.v[i];
     Vec3 omega = Vec3::Zero(), blend = Vec3::Zero();
-    for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+    KernelCache kernel;
+    for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
       const uint32_t j = nb.index[k];
       if (!isWater(p.phase[j])) continue;
       const Vec3 r = p.xPred[i] - p.xPred[j];
-      const float h = pairRadius(p.radius[i], p.radius[j]);
+      kernel.set(pairRadius(p.radius[i], p.radius[j]));
       // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
       const float vol = 2.0f * p.mass[j] / std::max(s.density[i] + s.density[j], 1e-3f);
       const Vec3 vij = p.v[j] - vi;
-      blend += vol * poly6(r.squaredNorm(), h) * vij;
-      omega += vol * vij.cross(spikyGrad(r, h));
+      blend += vol * kernel.poly6(r.squaredNorm()) * vij;
+      omega += vol * vij.cross(kernel.spikyGrad(r));
     }
     s.vorticity[i] = omega;
-    s.vNew[i] = vi + wp.viscosity * blend;
+    vNew[i] = vi + wp.viscosity * blend;
   });
   if (wp.vorticity > 0.0f) {
     // f = epsilon (N x omega), N = eta / |eta|, eta = grad |omega| (Macklin 2013 Eq. 16)
     parallelFor(nw, [&](int64_t w) {
       const size_t i = static_cast<size_t>(nc + w);
       Vec3 eta = Vec3::Zero();
-      for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+      KernelCache kernel;
+      for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
         const uint32_t j = nb.index[k];
         if (!isWater(p.phase[j])) continue;
         const float vol = p.mass[j] / std::max(s.density[j], 1e-3f);
-        eta += vol * s.vorticity[j].norm() * spikyGrad(p.xPred[i] - p.xPred[j], pairRadius(p.radius[i], p.radius[j]));
+        kernel.set(pairRadius(p.radius[i], p.radius[j]));
+        eta += vol * s.vorticity[j].norm() * kernel.spikyGrad(p.xPred[i] - p.xPred[j]);
       }
       const float len = eta.norm();
-      if (len > 1e-9f) s.vNew[i] += dt * wp.vorticity * (eta / len).cross(s.vorticity[i]);
+      if (len > 1e-9f) vNew[i] += dt * wp.vorticity * (eta / len).cross(s.vorticity[i]);
     });
   }
-  parallelFor(nw, [&](int64_t w) { p.v[nc + w] = s.vNew[nc + w]; });
+  parallelFor(nw, [&](int64_t w) { p.v[nc + w] = vNew[nc + w]; });
 }
 
 }  // namespace soak

@@ -16,9 +16,8 @@ struct FluidScratch {
   std::vector<float> psi;          // kg, Akinci boundary mass Psi_b = rho0 V_b of cloth particles
   std::vector<float> density;      // kg/m^3, rho_i of water particles (last iteration)
   std::vector<float> lambda;       // m^2, lambda_i / m_i of the density constraint
-  std::vector<Vec3> delta;         // m, position corrections of the current iteration
+  std::vector<Vec3> delta;         // m, position corrections of the current iteration; m/s, velocities after XSPH
   std::vector<Vec3> vorticity;     // 1/s, omega_i
-  std::vector<Vec3> vNew;          // m/s, velocities after XSPH
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
 };

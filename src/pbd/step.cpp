@@ -15,6 +15,8 @@ namespace soak {
 
 namespace {
 
+constexpr uint64_t kSortEverySteps = 10;  // the water moves less than a cell in 10 steps
+
 struct StageClock {
   std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
   double lap() {  // ms since the last lap
@@ -37,7 +39,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   solveGarments(model, state, ws.garment, ws.poses, h, stats);                      // Chen 2012: Eq. 1-5, 15-19, 3.5
   ms.garment += clock.lap();
   buildGrid(p.xPred, maxSupportRadius(p), ws.grid);                                 // neighbours of x*
-  buildNeighborLists(p.xPred, p.radius, ws.grid, ws.neighbors);
+  buildNeighborLists(p.xPred, p.radius, ws.grid, ws.neighbors, static_cast<uint32_t>(model.numCloth));
   ms.neighbors += clock.lap();
   computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
   scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
@@ -85,6 +87,8 @@ void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& 
   const auto start = std::chrono::steady_clock::now();
   const int n = std::max(1, model.solver.substeps);
   const float h = dt / static_cast<float>(n);
+  if (state.stepCount % kSortEverySteps == 0)                                       // water in cell order:
+    sortParticlesByCell(state.particles, model.numCloth, model.water.supportRadius, ws.reorder);  // neighbours close in memory
   for (int s = 0; s < n; ++s) substep(model, state, ws, h, stats);
   stats.substeps += n;
   stats.maxSpeed = maxSpeed(state.particles);

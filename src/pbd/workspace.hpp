@@ -4,6 +4,7 @@
 
 #include "garment/stage.hpp"
 #include "grid/grid.hpp"
+#include "grid/reorder.hpp"
 #include "pbd/cloth.hpp"
 #include "pbd/coupling.hpp"
 #include "pbd/fluid.hpp"
@@ -25,6 +26,7 @@ struct Workspace {
   std::vector<uint8_t> keep;            // particles kept after the domain check
   WettingScratch wetting;               // cloth wetting (Shao 2017 section 4)
   GarmentScratch garment;               // implicit garments and saturation mass (Chen 2012)
+  ReorderScratch reorder;               // keys and buffer of the water's sort by cell
 };
 
 }  // namespace soak

@@ -19,12 +19,10 @@ namespace {
 void markDrips(const Model& model, const State& state, std::vector<uint8_t>& isDrip) {
   const Particles& p = state.particles;
   isDrip.assign(p.size(), 0);
-  // ids ascend with the particle index (particles are appended with fresh ids and compacted stably)
-  const auto first = p.id.begin() + model.numCloth;
-  for (uint32_t id : state.dripId) {
-    const auto it = std::lower_bound(first, p.id.end(), id);
-    if (it != p.id.end() && *it == id) isDrip[static_cast<size_t>(it - p.id.begin())] = 1;
-  }
+  std::vector<int64_t> index;
+  findDrips(model, state, index);
+  for (const int64_t q : index)
+    if (q >= 0) isDrip[static_cast<size_t>(q)] = 1;
 }
 
 }  // namespace

@@ -17,14 +17,19 @@
 
 namespace soak {
 
-namespace {
-
-// index of the water particle with this id, or -1 (ids ascend with the index)
-int64_t findWater(const Model& model, const Particles& p, uint32_t id) {
-  const auto first = p.id.begin() + model.numCloth;
-  const auto it = std::lower_bound(first, p.id.end(), id);
-  return it != p.id.end() && *it == id ? static_cast<int64_t>(it - p.id.begin()) : -1;
+void findDrips(const Model& model, const State& state, std::vector<int64_t>& index) {
+  const Particles& p = state.particles;
+  const std::vector<uint32_t>& ids = state.dripId;  // ascending
+  index.assign(ids.size(), -1);
+  if (ids.empty()) return;
+  // one pass over the water: particles may be in any order (sorted by cell), ids are unique
+  for (size_t q = static_cast<size_t>(model.numCloth); q < p.size(); ++q) {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), p.id[q]);
+    if (it != ids.end() && *it == p.id[q]) index[static_cast<size_t>(it - ids.begin())] = static_cast<int64_t>(q);
+  }
 }
+
+namespace {
 
 // area-weighted normal of cloth particle i at positions x (zero when degenerate)
 Vec3 vertexNormal(const Model& model, const std::vector<Vec3>& x, int64_t i) {
@@ -145,8 +150,10 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   std::vector<int64_t>& dripOf = s.dripOf;
   dripOf.assign(static_cast<size_t>(nc), -1);
   size_t kept = 0;
+  std::vector<int64_t> dripIndex;
+  findDrips(model, state, dripIndex);
   for (size_t d = 0; d < state.dripId.size(); ++d) {
-    const int64_t q = findWater(model, p, state.dripId[d]);
+    const int64_t q = dripIndex[d];
     const int32_t src = state.dripSource[d];
     if (q < 0 || p.mass[q] <= 0.0f || (p.x[q] - p.x[src]).norm() >= p.radius[q]) continue;
     state.dripId[kept] = state.dripId[d];
@@ -205,8 +212,10 @@ void applyDripAttraction(const Model& model, State& state, const NeighborLists& 
   if (!w.enabled || !w.emission || nc == 0 || state.dripId.empty()) return;
   Particles& p = state.particles;
   const size_t covered = nb.start.size() - 1;  // particles the neighbour lists cover
+  std::vector<int64_t> dripIndex;
+  findDrips(model, state, dripIndex);
   for (size_t d = 0; d < state.dripId.size(); ++d) {
-    const int64_t q = findWater(model, p, state.dripId[d]);
+    const int64_t q = dripIndex[d];
     const int64_t src = state.dripSource[d];
     if (q < 0 || p.mass[q] <= 0.0f || static_cast<size_t>(src) >= covered) continue;
     const float hq = p.radius[q];

@@ -117,6 +117,10 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
 size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
                        WettingScratch& s, float h);
 
+// the particle index of each drip of state.dripId, -1 for one that is gone; the water particles may be
+// in any order (they are sorted by cell from time to time), so this does not rely on ids ascending
+void findDrips(const Model& model, const State& state, std::vector<int64_t>& index);
+
 // Eq. 19: the cloth around a drip pulls it (and is pulled back) until it is heavy enough to fall
 void applyDripAttraction(const Model& model, State& state, const NeighborLists& nb, const WettingScratch& s,
                          float h);

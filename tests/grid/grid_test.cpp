@@ -90,3 +90,89 @@ TEST(Grid, RebuildWithFewerParticles) {
   const auto ref = bruteForce(x, r);
   for (size_t i = 0; i < x.size(); ++i) EXPECT_EQ(lists.count(i), ref[i].size());
 }
+
+TEST(Grid, ClothNeighboursComeFirst) {
+  std::vector<Vec3> x;
+  std::vector<float> r;
+  randomSet(3000, 0.25f, true, 11, x, r);
+  const uint32_t firstWater = 1200;  // particles [0, 1200) play the cloth
+  NeighborGrid grid;
+  NeighborLists lists;
+  buildGrid(x, 0.04f, grid);
+  buildNeighborLists(x, r, grid, lists, firstWater);
+  const auto ref = bruteForce(x, r);
+  size_t cloth = 0, water = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    ASSERT_LE(lists.start[i], lists.mid[i]);
+    ASSERT_LE(lists.mid[i], lists.start[i + 1]);
+    EXPECT_EQ(lists.clothEnd(i, firstWater), lists.mid[i]);
+    EXPECT_EQ(lists.waterBegin(i, firstWater), lists.mid[i]);
+    for (uint32_t k = lists.start[i]; k < lists.mid[i]; ++k) EXPECT_LT(lists.index[k], firstWater);
+    for (uint32_t k = lists.mid[i]; k < lists.start[i + 1]; ++k) EXPECT_GE(lists.index[k], firstWater);
+    cloth += lists.mid[i] - lists.start[i];
+    water += lists.start[i + 1] - lists.mid[i];
+    std::vector<uint32_t> got(lists.index.begin() + lists.start[i], lists.index.begin() + lists.start[i + 1]);
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, ref[i]) << "particle " << i;
+  }
+  EXPECT_GT(cloth, 100u);
+  EXPECT_GT(water, 100u);
+  // lists built for another split give the whole list to both kinds (callers stay correct)
+  EXPECT_EQ(lists.clothEnd(5, 7), lists.start[6]);
+  EXPECT_EQ(lists.waterBegin(5, 7), lists.start[5]);
+}
+
+TEST(Grid, SplitListsDoNotDependOnThreadCount) {
+  std::vector<Vec3> x;
+  std::vector<float> r;
+  randomSet(20000, 0.4f, true, 13, x, r);  // more than one block of the fill pass
+  NeighborGrid g1, g2;
+  NeighborLists l1, l2;
+  setThreadCount(1);
+  buildGrid(x, 0.04f, g1);
+  buildNeighborLists(x, r, g1, l1, 2500);
+  setThreadCount(2);
+  buildGrid(x, 0.04f, g2);
+  buildNeighborLists(x, r, g2, l2, 2500);
+  EXPECT_EQ(l1.start, l2.start);
+  EXPECT_EQ(l1.mid, l2.mid);
+  EXPECT_EQ(l1.index, l2.index);
+}
+
+TEST(Grid, DenseClustersOverflowTheFillBuffer) {
+  // 600 particles in one cell: each has more neighbours than the gather buffers start with
+  std::vector<Vec3> x;
+  std::vector<float> r;
+  randomSet(600, 0.01f, false, 17, x, r);
+  NeighborGrid grid;
+  NeighborLists lists;
+  buildGrid(x, 0.04f, grid);
+  buildNeighborLists(x, r, grid, lists, 250);
+  const auto ref = bruteForce(x, r);
+  for (size_t i = 0; i < x.size(); ++i) {
+    std::vector<uint32_t> got(lists.index.begin() + lists.start[i], lists.index.begin() + lists.start[i + 1]);
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, ref[i]) << "particle " << i;
+  }
+}
+
+TEST(Grid, RebuildWithMoreNeighboursThanLastTime) {
+  // the second build needs more room than the first left: the index grows and stays right
+  std::vector<Vec3> x;
+  std::vector<float> r;
+  randomSet(12000, 0.6f, false, 19, x, r);
+  NeighborGrid grid;
+  NeighborLists lists;
+  buildGrid(x, 0.04f, grid);
+  buildNeighborLists(x, r, grid, lists, 4000);
+  for (Vec3& p : x) p *= 0.4f;  // the same particles, squeezed: about 15 times the neighbours
+  buildGrid(x, 0.04f, grid);
+  buildNeighborLists(x, r, grid, lists, 4000);
+  const auto ref = bruteForce(x, r);
+  for (size_t i = 0; i < x.size(); i += 7) {
+    std::vector<uint32_t> got(lists.index.begin() + lists.start[i], lists.index.begin() + lists.start[i + 1]);
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, ref[i]) << "particle " << i;
+  }
+  EXPECT_EQ(lists.start.back(), lists.index.size());
+}
