@@ -127,26 +127,10 @@ std::vector<Collider> readMannequin(ObjectReader& r, const std::string& name, Bo
   if (r.has("pose") && r.has("keyframes"))
     log.error(r.pathOf("keyframes"), "expected either pose or keyframes, got both");
   m.pose = readMannequinPose(r.object("pose"));
-  std::vector<PoseKey> keys;
-  if (const Json* ks = r.array("keyframes")) {
-    if (ks->empty()) log.expected(r.pathOf("keyframes"), "an array of at least one keyframe", *ks);
-    for (size_t i = 0; i < ks->size(); ++i) {
-      const std::string kp = indexPath(r.pathOf("keyframes"), i);
-      if (!(*ks)[i].is_object()) {
-        log.expected(kp, "an object (a pose keyframe: time, pose)", (*ks)[i]);
-        continue;
-      }
-      ObjectReader k(log, &(*ks)[i], kp);
-      PoseKey key;
-      key.time = k.number("time", std::nullopt, Range::nonNegative());
-      key.pose = readMannequinPose(k.object("pose"));
-      k.finish();
-      if (!keys.empty() && !(key.time > keys.back().time))
-        log.error(k.pathOf("time"), fmt::format("expected a time > the previous keyframe's ({} s), got {}",
-                                                keys.back().time, key.time));
-      keys.push_back(key);
-    }
-  }
+  const std::vector<PoseKey> keys =
+      readKeyframes<PoseKey>(r, "a pose keyframe: time, pose", [](ObjectReader& k, PoseKey& key) {
+        key.pose = readMannequinPose(k.object("pose"));
+      });
   m.sampleInterval = r.number("sampleInterval", d.sampleInterval, Range::positive());
   r.finish({"normal", "halfExtents", "wallThickness", "radius", "halfHeight", "path", "resolution", "padding",
             "restitution", "rotation"},

@@ -58,30 +58,10 @@ std::vector<Keyframe> readPose(ObjectReader& r, bool isPlane) {
     const Vec3 normal = r.unitVec3("normal", Vec3::UnitY());
     if (hasNormal) still.rotation = Quat::FromTwoVectors(Vec3::UnitY(), normal).normalized();
   }
-  const Json* keys = r.array("keyframes");
-  if (!keys) return {still};
-  if (keys->empty()) {
-    log.expected(r.pathOf("keyframes"), "an array of at least one keyframe", *keys);
-    return {still};
-  }
-  std::vector<Keyframe> out;
-  for (size_t i = 0; i < keys->size(); ++i) {
-    const std::string kp = indexPath(r.pathOf("keyframes"), i);
-    if (!(*keys)[i].is_object()) {
-      log.expected(kp, "an object (a keyframe)", (*keys)[i]);
-      continue;
-    }
-    ObjectReader k(log, &(*keys)[i], kp);
-    Keyframe key;
-    key.time = k.number("time", std::nullopt, Range::nonNegative());
+  std::vector<Keyframe> out = readKeyframes<Keyframe>(r, "a keyframe", [](ObjectReader& k, Keyframe& key) {
     key.translation = k.vec3("position", Vec3::Zero());
     key.rotation = readRotation(k.object("rotation"));
-    k.finish();
-    if (!out.empty() && !(key.time > out.back().time))
-      log.error(k.pathOf("time"), fmt::format("expected a time > the previous keyframe's ({} s), got {}",
-                                              out.back().time, key.time));
-    out.push_back(key);
-  }
+  });
   return out.empty() ? std::vector<Keyframe>{still} : out;
 }
 
