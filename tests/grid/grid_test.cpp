@@ -59,18 +59,22 @@ TEST_P(GridVsBruteForce, SameNeighbours) {
 INSTANTIATE_TEST_SUITE_P(Grid, GridVsBruteForce,
                          ::testing::Combine(::testing::Bool(), ::testing::Values(1u, 2u, 3u)));
 
+// grid and lists of x built on `threads` threads, cloth before water at `split`
+NeighborLists listsOn(int threads, const std::vector<Vec3>& x, const std::vector<float>& r, uint32_t split) {
+  NeighborGrid g;
+  NeighborLists l;
+  setThreadCount(threads);
+  buildGrid(x, 0.04f, g);
+  buildNeighborLists(x, r, g, l, split);
+  setThreadCount(2);
+  return l;
+}
+
 TEST(Grid, ListsDoNotDependOnThreadCount) {
   std::vector<Vec3> x;
   std::vector<float> r;
   randomSet(5000, 0.3f, true, 7, x, r);
-  NeighborGrid g1, g2;
-  NeighborLists l1, l2;
-  setThreadCount(1);
-  buildGrid(x, 0.04f, g1);
-  buildNeighborLists(x, r, g1, l1);
-  setThreadCount(2);
-  buildGrid(x, 0.04f, g2);
-  buildNeighborLists(x, r, g2, l2);
+  const NeighborLists l1 = listsOn(1, x, r, 0), l2 = listsOn(2, x, r, 0);
   EXPECT_EQ(l1.start, l2.start);
   EXPECT_EQ(l1.index, l2.index);
 }
@@ -126,14 +130,7 @@ TEST(Grid, SplitListsDoNotDependOnThreadCount) {
   std::vector<Vec3> x;
   std::vector<float> r;
   randomSet(20000, 0.4f, true, 13, x, r);  // more than one block of the fill pass
-  NeighborGrid g1, g2;
-  NeighborLists l1, l2;
-  setThreadCount(1);
-  buildGrid(x, 0.04f, g1);
-  buildNeighborLists(x, r, g1, l1, 2500);
-  setThreadCount(2);
-  buildGrid(x, 0.04f, g2);
-  buildNeighborLists(x, r, g2, l2, 2500);
+  const NeighborLists l1 = listsOn(1, x, r, 2500), l2 = listsOn(2, x, r, 2500);
   EXPECT_EQ(l1.start, l2.start);
   EXPECT_EQ(l1.mid, l2.mid);
   EXPECT_EQ(l1.index, l2.index);
