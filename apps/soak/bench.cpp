@@ -1,6 +1,7 @@
 // `soak bench`: times the solver stages on the scenes of bench/benchmarks.json (bench/README.md).
 // Each scene runs in its own process (this program re-executed) so its peak memory is its own.
 #include "commands.hpp"
+#include "progress.hpp"
 
 #include <soak/error.hpp>
 #include <soak/scene.hpp>
@@ -137,6 +138,7 @@ uint64_t peakRssBytes() {
 json runOne(const BenchJob& job, int threads, bool quiet) {
   Scene scene = loadScene(job.scene, job.overrides);
   if (threads > 0) setThreadCount(threads);
+  if (!quiet) std::fputs(busyMachineHint(threadCount()).c_str(), stderr);
   const Model& model = scene.model;
   State& state = scene.state;
   const float dt = model.solver.dt;

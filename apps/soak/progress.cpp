@@ -4,10 +4,28 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 #include <unistd.h>
 
 namespace soak::cli {
+
+std::string busyMachineHint(int threads) {
+  if (threads < 2) return "";
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  if (policy && (std::string(policy) == "PASSIVE" || std::string(policy) == "passive")) return "";
+  double load = 0.0;
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  if (getloadavg(&load, 1) != 1 || cores < 1 || load < static_cast<double>(cores)) return "";
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "soak: note: this machine is busy (load %.1f on %ld cores); with OpenMP's default spinning "
+                "waits soak can be several times slower here: OMP_WAIT_POLICY=PASSIVE helps "
+                "(docs/performance.md)\n",
+                load, cores);
+  return text;
+}
 
 Progress::Progress(int frames, bool enabled)
     : frames_(frames), enabled_(enabled), tty_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}

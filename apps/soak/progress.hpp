@@ -23,4 +23,9 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
 };
 
+// a one-line hint when the machine is busy (1-minute load average at least the number of cores) and
+// OpenMP threads spin while waiting (OMP_WAIT_POLICY unset or ACTIVE): each of the step's many
+// barriers then waits for a descheduled thread (docs/performance.md). Empty otherwise.
+std::string busyMachineHint(int threads);
+
 }  // namespace soak::cli

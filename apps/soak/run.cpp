@@ -150,6 +150,7 @@ int runCommand(const RunOptions& o) {
   // everything that can be wrong with the input fails here, before any output exists
   Scene scene = loadScene(o.scene, o.overrides);
   if (o.threads > 0) setThreadCount(o.threads);
+  if (!o.quiet) std::fputs(busyMachineHint(threadCount()).c_str(), stderr);
   const Model& model = scene.model;
   State& state = scene.state;
   const OutputSettings& out = scene.output;
