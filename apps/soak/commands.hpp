@@ -7,6 +7,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace soak::cli {
@@ -57,6 +58,8 @@ struct RenderCliOptions {
   RenderOptions options;
   bool surface = false, particles = false;  // water style flags
   std::string camera, lookAt;               // "X,Y,Z"
+  // the camera options given on the command line (they win over the scene's "view")
+  CLI::Option *fovOpt = nullptr, *azimuthOpt = nullptr, *elevationOpt = nullptr, *zoomOpt = nullptr;
   bool quiet = false;
 };
 struct SurfaceCliOptions {

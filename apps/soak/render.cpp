@@ -1,5 +1,6 @@
 // `soak render` and `soak surface`: options, a progress bar and a summary around src/render/
 #include "render/render.hpp"
+#include "render/run_output.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -98,13 +99,13 @@ CLI::App* addRenderCommand(CLI::App& app, RenderCliOptions& o) {
       ->check(checkPoint);
   cmd->add_option("--look-at", o.lookAt, "point the camera looks at, X,Y,Z (default: the centre of everything)")
       ->check(checkPoint);
-  cmd->add_option("--fov", o.options.camera.fovDegrees, "horizontal field of view in degrees (default 40)");
-  cmd->add_option("--azimuth", o.options.camera.azimuthDegrees,
+  o.fovOpt = cmd->add_option("--fov", o.options.camera.fovDegrees, "horizontal field of view in degrees (default 40)");
+  o.azimuthOpt = cmd->add_option("--azimuth", o.options.camera.azimuthDegrees,
                   "automatic camera: direction around y, degrees from +z towards +x (default 35)");
-  cmd->add_option("--elevation", o.options.camera.elevationDegrees,
+  o.elevationOpt = cmd->add_option("--elevation", o.options.camera.elevationDegrees,
                   "automatic camera: degrees above the horizontal (default 25)")
       ->check(CLI::Range(-89.0, 89.0));
-  cmd->add_option("--zoom", o.options.camera.zoom, "automatic camera: move closer by this factor (default 1)")
+  o.zoomOpt = cmd->add_option("--zoom", o.options.camera.zoom, "automatic camera: move closer by this factor (default 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--fps", o.options.fps, "video frame rate (default: real time, 1 / (stepsPerFrame dt))")
       ->check(CLI::NonNegativeNumber);
@@ -149,6 +150,16 @@ int renderCommand(RenderCliOptions& o) {
   if (o.surface) r.water = WaterStyle::Surface;
   r.camera.position = parsePoint(o.camera);
   r.camera.lookAt = parsePoint(o.lookAt);
+  {  // the scene's "view" fills what the command line left out
+    const ViewSettings view = openRunOutput(r.runDir).scene.view;
+    const auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
+    if (!r.camera.position && view.camera) r.camera.position = view.camera;
+    if (!r.camera.lookAt && view.lookAt) r.camera.lookAt = view.lookAt;
+    if (!given(o.fovOpt) && view.fov) r.camera.fovDegrees = *view.fov;
+    if (!given(o.azimuthOpt) && view.azimuth) r.camera.azimuthDegrees = *view.azimuth;
+    if (!given(o.elevationOpt) && view.elevation) r.camera.elevationDegrees = *view.elevation;
+    if (!given(o.zoomOpt) && view.zoom) r.camera.zoom = *view.zoom;
+  }
   FrameBar bar("frame", !o.quiet);
   const RenderResult res = renderRun(r, [&bar](int done, int total) { bar.update(done, total); });
   bar.finish();

@@ -3,6 +3,7 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,16 @@ struct OutputSettings {
   std::string colorRamp = "red";  // cloth OBJ vertex colours by saturation: "red" (Fig. 3), "green" (Fig. 4), "none"
 };
 
+// how `soak render` looks at the scene's runs ("view"); an absent value is chosen automatically or
+// taken from the command line, which wins over the scene (docs/rendering.md)
+struct ViewSettings {
+  std::optional<Vec3> camera, lookAt;  // m
+  std::optional<float> fov;            // deg, horizontal
+  std::optional<float> azimuth;        // deg around +y from +z towards +x (automatic camera)
+  std::optional<float> elevation;      // deg above the horizontal (automatic camera)
+  std::optional<float> zoom;           // automatic camera distance divided by this
+};
+
 struct Scene {
   std::string path;          // file it came from ("<string>" when parsed from memory)
   std::string name;
@@ -24,6 +35,7 @@ struct Scene {
   Model model;
   State state;               // initial state (cloth particles placed, blocks not yet emitted)
   OutputSettings output;
+  ViewSettings view;
 };
 
 // loads and validates a scene file. overrides are "json.path=value" strings applied before

@@ -138,6 +138,20 @@ void readOutput(ObjectReader r, OutputSettings& o) {
   r.finish();
 }
 
+// "view": the camera soak render uses unless its command line says otherwise
+void readView(ObjectReader r, ViewSettings& v) {
+  if (!r.present()) return;
+  if (r.has("camera")) v.camera = r.vec3("camera", std::nullopt);
+  if (r.has("lookAt")) v.lookAt = r.vec3("lookAt", std::nullopt);
+  if (r.has("fov")) v.fov = r.number("fov", std::nullopt, Range{1.0, 179.0, true, true});
+  if (r.has("azimuth")) v.azimuth = r.number("azimuth", std::nullopt);
+  if (r.has("elevation")) v.elevation = r.number("elevation", std::nullopt, Range::between(-89.0, 89.0));
+  if (r.has("zoom")) v.zoom = r.number("zoom", std::nullopt, Range::positive());
+  r.finish();
+  if (v.camera && v.lookAt && (*v.camera - *v.lookAt).norm() < 1e-6f)
+    r.log().error(r.pathOf("lookAt"), fmt::format("expected a point other than view.camera, got {}", fmtVec(*v.lookAt)));
+}
+
 // "wetting" (Shao 2017 section 4): a present section is enabled unless "enabled": false
 void readWetting(ObjectReader r, WettingParams& w) {
   const WettingParams d;
@@ -554,6 +568,7 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   readSolver(top.object("solver"), model.solver);
   readWater(top.object("water"), model.water);
   readOutput(top.object("output"), scene.output);
+  readView(top.object("view"), scene.view);
   readWetting(top.object("wetting"), model.wetting);
   const int maxVertices = model.solver.maxParticles;
   Bodies bodies;  // mannequins by name, for the garments sewn around them

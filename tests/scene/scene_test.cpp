@@ -274,6 +274,20 @@ TEST(SceneErrors, WrongTypeAndOutOfRange) {
   EXPECT_HAS(errorWith("cloth.0.mesh.axisV=[0, 0, 0]"), "at cloth[0].mesh.axisV: expected a non-zero direction");
 }
 
+TEST(SceneBuild, ViewIsReadForTheRenderer) {
+  const Scene none = fromString(kSmall);
+  EXPECT_FALSE(none.view.camera || none.view.lookAt || none.view.fov || none.view.zoom);
+  const Scene s = fromString(kSmall, {"view={\"camera\": [1, 2, 3], \"lookAt\": [0, 1, 0], \"fov\": 30, \"zoom\": 2}"});
+  ASSERT_TRUE(s.view.camera && s.view.lookAt && s.view.fov && s.view.zoom);
+  EXPECT_TRUE(s.view.camera->isApprox(Vec3(1, 2, 3)));
+  EXPECT_FLOAT_EQ(*s.view.fov, 30.0f);
+  EXPECT_FALSE(s.view.azimuth.has_value());
+  EXPECT_HAS(errorWith("view.fov=200"), "at view.fov: expected a number in (1, 179)");
+  EXPECT_HAS(errorWith("view={\"camera\": [0, 1, 0], \"lookAt\": [0, 1, 0]}"),
+             "at view.lookAt: expected a point other than view.camera");
+  EXPECT_HAS(errorWith("view.light=1"), "unknown key 'light'");
+}
+
 TEST(SceneErrors, BadEnumListsTheAllowedValues) {
   EXPECT_HAS(loadError(R"({"cloth": [], "emitters": [{"type": "block", "min": [0,0,0], "max": [1,1,1]}],
                            "colliders": [{"type": "cube"}]})"),
