@@ -38,24 +38,38 @@ std::string Progress::formatDuration(double s) {
   return fmt::format("{}:{:02d}:{:02d}", total / 3600, (total / 60) % 60, total % 60);
 }
 
+double Progress::seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
 void Progress::update(int frame, double simTime, double msPerStep) {
   if (!enabled_ || frames_ <= 0) return;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  const double eta = elapsed / frame * (frames_ - frame);
-  const std::string info = fmt::format("frame {}/{}  t = {:.3f} s  {:.1f} ms/step  ETA {}", frame, frames_, simTime,
-                                       msPerStep, formatDuration(eta));
+  const double eta = seconds() / frame * (frames_ - frame);
+  show(frame, frames_,
+       fmt::format("frame {}/{}  t = {:.3f} s  {:.1f} ms/step  ETA {}", frame, frames_, simTime, msPerStep,
+                   formatDuration(eta)));
+}
+
+void Progress::updateItems(const char* what, int done, int total) {
+  if (!enabled_ || total <= 0 || done <= 0) return;
+  const double elapsed = seconds();
+  show(done, total, fmt::format("{} {}/{}  {} elapsed  ETA {}", what, done, total, formatDuration(elapsed),
+                                formatDuration(elapsed / done * (total - done))));
+}
+
+void Progress::show(int done, int total, const std::string& info) {
   if (tty_) {
     constexpr int kWidth = 30;
-    const int filled = frame * kWidth / frames_;
+    const int filled = done * kWidth / total;
     std::fprintf(stderr, "\r[%s%s] %s\033[K", std::string(filled, '#').c_str(),
                  std::string(kWidth - filled, '.').c_str(), info.c_str());
     std::fflush(stderr);
     drawn_ = true;
     return;
   }
-  // a log file gets a line at each new tenth (and the last frame)
-  const int decile = frame * 10 / frames_;
-  if (decile > lastDecile_ || frame == frames_) {
+  // a log file gets a line at each new tenth (and the last item)
+  const int decile = done * 10 / total;
+  if (decile > lastDecile_ || done == total) {
     lastDecile_ = decile;
     std::fprintf(stderr, "soak: %s\n", info.c_str());
   }

@@ -10,6 +10,10 @@ class Progress {
   Progress(int frames, bool enabled);
   // after frame `frame` (1..frames) at simulated time t (s) with the frame's mean ms per step
   void update(int frame, double simTime, double msPerStep);
+  // after `done` of `total` items of any kind: "<what> done/total  ELAPSED elapsed  ETA ..."
+  void updateItems(const char* what, int done, int total);
+  // wall time since the bar was made, s
+  double seconds() const;
   // ends the bar's line (a terminal needs the newline)
   void finish();
   // "1:02:03", "4:05" or "6.7 s"
@@ -21,6 +25,8 @@ class Progress {
   int lastDecile_ = 0;
   bool drawn_ = false;
   std::chrono::steady_clock::time_point start_;
+  // draws `info` with a bar at done / total: redrawn on a terminal, a line at each new tenth otherwise
+  void show(int done, int total, const std::string& info);
 };
 
 // a one-line hint when the machine is busy (1-minute load average at least the number of cores) and

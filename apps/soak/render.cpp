@@ -37,43 +37,6 @@ std::optional<Vec3> parsePoint(const std::string& s) {
   return Vec3(x, y, z);
 }
 
-// a bar of frames done on a terminal, a line at each tenth otherwise
-class FrameBar {
- public:
-  FrameBar(const char* what, bool enabled)
-      : what_(what), enabled_(enabled), tty_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
-  void update(int done, int total) {
-    if (!enabled_ || total <= 0) return;
-    const double elapsed = seconds();
-    const std::string info =
-        fmt::format("{} {}/{}  {} elapsed  ETA {}", what_, done, total, Progress::formatDuration(elapsed),
-                    Progress::formatDuration(elapsed / done * (total - done)));
-    if (tty_) {
-      constexpr int kWidth = 30;
-      const int filled = done * kWidth / total;
-      std::fprintf(stderr, "\r[%s%s] %s\033[K", std::string(filled, '#').c_str(),
-                   std::string(kWidth - filled, '.').c_str(), info.c_str());
-      std::fflush(stderr);
-      drawn_ = true;
-    } else if (done * 10 / total > lastDecile_ || done == total) {
-      lastDecile_ = done * 10 / total;
-      std::fprintf(stderr, "soak: %s\n", info.c_str());
-    }
-  }
-  void finish() {
-    if (drawn_) std::fputc('\n', stderr);
-    drawn_ = false;
-  }
-  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
-
- private:
-  const char* what_;
-  bool enabled_, tty_;
-  bool drawn_ = false;
-  int lastDecile_ = 0;
-  std::chrono::steady_clock::time_point start_;
-};
-
 std::string frameSpan(const std::vector<int>& frames) {
   return frames.size() == 1 ? fmt::format("frame {}", frames.front())
                             : fmt::format("frames {}..{}", frames.front(), frames.back());
@@ -160,8 +123,8 @@ int renderCommand(RenderCliOptions& o) {
     if (!given(o.elevationOpt) && view.elevation) r.camera.elevationDegrees = *view.elevation;
     if (!given(o.zoomOpt) && view.zoom) r.camera.zoom = *view.zoom;
   }
-  FrameBar bar("frame", !o.quiet);
-  const RenderResult res = renderRun(r, [&bar](int done, int total) { bar.update(done, total); });
+  Progress bar(0, !o.quiet);
+  const RenderResult res = renderRun(r, [&bar](int done, int total) { bar.updateItems("frame", done, total); });
   bar.finish();
   if (!o.quiet) {
     std::printf("soak: rendered %s to %s (frame_NNNN.png, %d x %d, %s water, %s ramp) in %s with %d jobs\n",
@@ -178,8 +141,9 @@ int renderCommand(RenderCliOptions& o) {
 }
 
 int surfaceCommand(SurfaceCliOptions& o) {
-  FrameBar bar("frame", !o.quiet);
-  const SurfaceResult res = surfaceRun(o.options, [&bar](int done, int total) { bar.update(done, total); });
+  Progress bar(0, !o.quiet);
+  const SurfaceResult res =
+      surfaceRun(o.options, [&bar](int done, int total) { bar.updateItems("frame", done, total); });
   bar.finish();
   if (!o.quiet) {
     std::string kinds;

@@ -84,6 +84,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.contacts += static_cast<uint64_t>(r.contacts);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
   }
+  if (s.pieces.empty()) return;
   // remember where the solve put the implicit cloth, so the coupling's push can become velocity
   s.solved.resize(static_cast<size_t>(model.numCloth));
   for (int64_t i = 0; i < model.numCloth; ++i)
@@ -91,7 +92,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
 }
 
 void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch& s, float h) {
-  if (s.solved.size() < static_cast<size_t>(model.numCloth)) return;
+  if (s.pieces.empty() || s.solved.size() < static_cast<size_t>(model.numCloth)) return;
   const float inv = 1.0f / h;
   parallelFor(model.numCloth, [&](int64_t i) {
     if (!model.implicitCloth(i)) return;
