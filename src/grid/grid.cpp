@@ -3,6 +3,9 @@
 #include "core/parallel.hpp"
 
 #include <omp.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include <algorithm>
 
@@ -88,17 +91,25 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   lists.firstWater = firstWater;
   lists.start.resize(n + 1);
   lists.mid.resize(n);
-  lists.packed.resize(n);
   lists.start[0] = 0;
-  using Packed = NeighborLists::Packed;
-  Packed* packed = lists.packed.data();
+  // candidates read their position and radius from contiguous arrays in bucket order
+  lists.px.resize(n);
+  lists.py.resize(n);
+  lists.pz.resize(n);
+  lists.ph.resize(n);
+  float* px = lists.px.data();
+  float* py = lists.py.data();
+  float* pz = lists.pz.data();
+  float* ph = lists.ph.data();
   const uint32_t* entries = grid.cellEntries.data();
   const float cs = grid.cellSize;
   const bool parallel = static_cast<int64_t>(n) >= kParallelGrain;
-  // candidates read their position and radius from one contiguous array in bucket order
   parallelFor(static_cast<int64_t>(n), [&](int64_t k) {
     const uint32_t j = entries[k];
-    packed[k] = {x[j].x(), x[j].y(), x[j].z(), radius[j]};
+    px[k] = x[j].x();
+    py[k] = x[j].y();
+    pz[k] = x[j].z();
+    ph[k] = radius[j];
   });
 
   // the neighbours of i, cloth ones to cl[0 .. nCloth) and water ones to wa[0 .. nWater), in a
@@ -115,14 +126,41 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
     for (int r = 0; r < cache.count; ++r) {
       if (!RangeCache::touches(cache.offset[r], f, cs, reach2)) continue;
       const uint32_t k0 = cache.ranges[r][0], k1 = cache.ranges[r][1];
-      if (ncl + (k1 - k0) > cl.size()) cl.resize(2 * (ncl + (k1 - k0)));
-      if (nwa + (k1 - k0) > wa.size()) wa.resize(2 * (nwa + (k1 - k0)));
+      if (ncl + (k1 - k0) + 16 > cl.size()) cl.resize(2 * (ncl + (k1 - k0) + 16));  // + 16: whole-vector stores
+      if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));
       uint32_t* pc = cl.data();
       uint32_t* pw = wa.data();
-      for (uint32_t k = k0; k < k1; ++k) {
-        const Packed q = packed[k];
-        const float dx = xi - q.x, dy = yi - q.y, dz = zi - q.z;
-        const float h = 0.5f * (hi + q.h);
+      uint32_t k = k0;
+#if defined(__AVX512F__)
+      // 16 candidates at a time; the neighbours are compressed into the lists in candidate order,
+      // so the lists are the same as the scalar loop's
+      const __m512 vx = _mm512_set1_ps(xi), vy = _mm512_set1_ps(yi), vz = _mm512_set1_ps(zi);
+      const __m512 vh = _mm512_set1_ps(hi), half = _mm512_set1_ps(0.5f);
+      const __m512i self = _mm512_set1_epi32(static_cast<int>(i)), split = _mm512_set1_epi32(static_cast<int>(firstWater));
+      for (; k < k1; k += 16) {
+        const __mmask16 lanes = k1 - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (k1 - k)) - 1u);
+        const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, px + k));
+        const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, py + k));
+        const __m512 dz = _mm512_sub_ps(vz, _mm512_maskz_loadu_ps(lanes, pz + k));
+        const __m512 h = _mm512_mul_ps(half, _mm512_add_ps(vh, _mm512_maskz_loadu_ps(lanes, ph + k)));
+        // (dx^2 + dy^2) + dz^2, rounded as the scalar expression (no FMA)
+        const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+        const __m512i j = _mm512_maskz_loadu_epi32(lanes, entries + k);
+        const __mmask16 in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(h, h), _CMP_LT_OQ) &
+                             _mm512_cmpneq_epi32_mask(j, self);
+        const __mmask16 isCloth = _mm512_cmplt_epu32_mask(j, split);
+        const __mmask16 inCloth = in & isCloth, inWater = in & static_cast<__mmask16>(~isCloth);
+        // compress in a register and store all 16 lanes (the lists have room): a compressing store
+        // to memory is microcoded and slow on AMD Zen 4
+        _mm512_storeu_si512(pc + ncl, _mm512_maskz_compress_epi32(inCloth, j));
+        _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(inWater, j));
+        ncl += static_cast<uint32_t>(__builtin_popcount(inCloth));
+        nwa += static_cast<uint32_t>(__builtin_popcount(inWater));
+      }
+#else
+      for (; k < k1; ++k) {
+        const float dx = xi - px[k], dy = yi - py[k], dz = zi - pz[k];
+        const float h = 0.5f * (hi + ph[k]);
         const uint32_t j = entries[k];
         const uint32_t in = (dx * dx + dy * dy + dz * dz < h * h) & (j != static_cast<uint32_t>(i));
         const uint32_t isCloth = j < firstWater;
@@ -131,6 +169,7 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
         ncl += in & isCloth;
         nwa += in & (isCloth ^ 1u);
       }
+#endif
     }
     nCloth = ncl;
     nWater = nwa;

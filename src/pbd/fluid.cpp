@@ -30,17 +30,37 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
 
 namespace {
 
+// the kernel constants of one pair, from its support radius h: one division, no h^9 divisions.
+// Written for the vectorised neighbour loops below (omp simd): no branches, only selects.
+struct PairKernel {
+  float h, h2, poly6Coef, spikyCoef;
+};
+inline PairKernel pairKernel(float h) {
+  const float inv = 1.0f / h, inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+  return {h, h * h, (315.0f / (64.0f * kPi)) * inv6 * inv3, (-45.0f / kPi) * inv6};
+}
+inline float poly6Of(const PairKernel& k, float r2) {
+  const float d = std::max(k.h2 - r2, 0.0f);
+  return k.poly6Coef * d * d * d;
+}
+// the factor f of grad W_spiky = f r (r = x_i - x_j), 0 outside the support and at r = 0
+inline float spikyFactorOf(const PairKernel& k, float r2) {
+  const float len = std::sqrt(r2);
+  const float d = k.h - len;
+  return (len < k.h && len > 1e-9f) ? k.spikyCoef * d * d / std::max(len, 1e-9f) : 0.0f;
+}
+
 // artificial pressure s_corr = -k (W_ij / W(dq))^n (Macklin 2013 Eq. 13), in lambda units. With
-// dq = c h, W_ij / W(dq) = ((h^2 - r^2) / (h^2 (1 - c^2)))^3: one division, no h^9
-float tensileCorrection(const WaterParams& w, float r2, float h, float scale) {
-  if (w.tensileK <= 0.0f) return 0.0f;
-  const float h2 = h * h;
-  if (r2 >= h2) return 0.0f;
-  const float q = (h2 - r2) / (h2 * (1.0f - w.tensileDq * w.tensileDq));
-  const float ratio = q * q * q;
-  float power = 1.0f;
-  for (int k = 0; k < w.tensileN; ++k) power *= ratio;
-  return -w.tensileK * power * scale;
+// dq = c h, W_ij / W(dq) = ((h^2 - r^2) / (h^2 (1 - c^2)))^3; the power by squaring (n < 64, the
+// scene's range), so the loop vectorises
+inline float tensileCorrection(float k, float oneMinusDq2, int n, float r2, float h2) {
+  const float q = std::max(h2 - r2, 0.0f) / (h2 * oneMinusDq2);
+  float base = q * q * q, power = 1.0f;
+  for (int bit = 0; bit < 6; ++bit) {
+    power *= ((n >> bit) & 1) ? base : 1.0f;
+    base *= base;
+  }
+  return -k * power;
 }
 
 // sum_k w_k |grad_k C|^2 of a water particle at rest in a full cubic lattice (for the s_corr scale)
@@ -63,6 +83,9 @@ float restGradientNorm(const WaterParams& w) {
 
 }  // namespace
 
+// The neighbour loops are written for `omp simd` (gathers of j's data, reductions over the list):
+// the sum of one particle is then taken in an order fixed by the compiled code, the same for any
+// thread count, but not the order of a scalar loop (docs/performance.md).
 void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
                 FluidScratch& s, int iterations) {
   const WaterParams& wp = model.water;
@@ -71,36 +94,51 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const int64_t nw = static_cast<int64_t>(n) - nc;
   if (nw <= 0) return;
   const float rho0 = wp.restDensity, invRho0 = 1.0f / rho0;
-  s.density.resize(n);
-  s.lambda.resize(n);
+  s.density.assign(n, 0.0f);  // cloth entries stay 0 (the velocity pass reads them as masked lanes)
+  s.lambda.assign(n, 0.0f);  // cloth entries stay 0: a boundary particle has no constraint of its own
   s.delta.resize(n);
+  s.massOrPsi.resize(n);
   if (s.sCorrScale == 0.0f) s.sCorrScale = 1.0f / (wp.particleMass * restGradientNorm(wp));
-  const float sCorrScale = s.sCorrScale;
+  const float sCorrK = wp.tensileK * s.sCorrScale, oneMinusDq2 = 1.0f - wp.tensileDq * wp.tensileDq;
+  const int tensileN = wp.tensileN;
   boundaryParts(model, poses, s.parts);
+  // the mass a neighbour lends the density: its own for water, the boundary mass Psi_b for cloth
+  parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.massOrPsi[j] = j < nc ? s.psi[j] : p.mass[j]; });
+  const float* X = p.xPred[0].data();
+  const float* H = p.radius.data();
+  const float* M = s.massOrPsi.data();
+  const float* W = p.invMass.data();
+  const float* L = s.lambda.data();
+  const int32_t* phase = p.phase.data();
+  const uint32_t* index = nb.index.data();
 
   for (int it = 0; it < iterations; ++it) {
     // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
     parallelFor(nw, [&](int64_t w) {
       const size_t i = static_cast<size_t>(nc + w);
-      const Vec3 xi = p.xPred[i];
-      const float hi = p.radius[i], mi = p.mass[i];
-      float rho = mi * poly6(0.0f, hi);
-      Vec3 gradI = Vec3::Zero();
+      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+      const float hi = H[i], mi = p.mass[i];
+      float rho = 0.0f, gx = 0.0f, gy = 0.0f, gz = 0.0f;
       float sumOthers = 0.0f;  // sum over neighbours of w_k |grad_k C|^2
-      KernelCache kernel;
+#pragma omp simd reduction(+ : rho, gx, gy, gz, sumOthers)
       for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
-        const uint32_t j = nb.index[k];
-        const Vec3 r = xi - p.xPred[j];
-        kernel.set(pairRadius(hi, p.radius[j]));
-        const float mj = isWater(p.phase[j]) ? p.mass[j] : s.psi[j];  // cloth: boundary mass Psi_b
-        rho += mj * kernel.poly6(r.squaredNorm());
-        const Vec3 g = (mj * invRho0) * kernel.spikyGrad(r);
-        gradI += g;
-        sumOthers += p.invMass[j] * g.squaredNorm();
+        const uint32_t j = index[k];
+        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+        const float r2 = rx * rx + ry * ry + rz * rz;
+        const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
+        const float mj = M[j];
+        rho += mj * poly6Of(kern, r2);
+        const float f = mj * invRho0 * spikyFactorOf(kern, r2);
+        gx += f * rx;
+        gy += f * ry;
+        gz += f * rz;
+        sumOthers += W[j] * f * f * r2;
       }
+      rho += mi * poly6(0.0f, hi);
+      Vec3 gradI(gx, gy, gz);
       // colliders as a continuous wall of boundary particles
       Vec3 gradWall;
-      rho += rho0 * boundaryFraction(s.parts, xi, hi, &gradWall);
+      rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi, &gradWall);
       gradI += gradWall;
       s.delta[i] = gradWall;  // kept for the corrections below (same positions): one wall query per iteration
       s.density[i] = rho;
@@ -110,46 +148,49 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       const float denom = p.invMass[i] * gradI.squaredNorm() + sumOthers + wp.relaxation * p.invMass[i] / (hi * hi);
       s.lambda[i] = -C / (mi * denom);
     });
-    // water corrections: dx_i = 1/rho0 sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (+ boundaries)
+    // water corrections: dx_i = 1/rho0 sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (+ boundaries);
+    // a cloth neighbour has lambda 0 and no s_corr: Psi_b lambda_i grad W_ib
     parallelFor(nw, [&](int64_t w) {
       const size_t i = static_cast<size_t>(nc + w);
-      const Vec3 xi = p.xPred[i];
-      const float hi = p.radius[i], li = s.lambda[i];
-      Vec3 dx = Vec3::Zero();
-      KernelCache kernel;
+      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+      const float hi = H[i], li = L[i];
+      float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+#pragma omp simd reduction(+ : dx, dy, dz)
       for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
-        const uint32_t j = nb.index[k];
-        const Vec3 r = xi - p.xPred[j];
-        const float h = pairRadius(hi, p.radius[j]);
-        kernel.set(h);
-        if (isWater(p.phase[j])) {
-          const float sc = tensileCorrection(wp, r.squaredNorm(), h, sCorrScale);
-          dx += p.mass[j] * (li + s.lambda[j] + sc) * kernel.spikyGrad(r);
-        } else {
-          dx += s.psi[j] * li * kernel.spikyGrad(r);
-        }
+        const uint32_t j = index[k];
+        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+        const float r2 = rx * rx + ry * ry + rz * rz;
+        const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
+        const float sc = phase[j] == kWaterPhase ? sCorrK * tensileCorrection(1.0f, oneMinusDq2, tensileN, r2, kern.h2) : 0.0f;
+        const float f = M[j] * (li + L[j] + sc) * spikyFactorOf(kern, r2);
+        dx += f * rx;
+        dy += f * ry;
+        dz += f * rz;
       }
-      dx += rho0 * li * s.delta[i];  // the wall gradient of the lambda pass (zero away from walls)
-      s.delta[i] = dx / rho0;
+      s.delta[i] = (Vec3(dx, dy, dz) + rho0 * li * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
     });
     // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
     parallelFor(nc, [&](int64_t b) {
       s.delta[b].setZero();
       if (p.invMass[b] == 0.0f) return;
-      Vec3 dx = Vec3::Zero();
+      const float xb = X[3 * b], yb = X[3 * b + 1], zb = X[3 * b + 2], hb = H[b];
+      float dx = 0.0f, dy = 0.0f, dz = 0.0f;
       int pushing = 0;
-      KernelCache kernel;
+#pragma omp simd reduction(+ : dx, dy, dz, pushing)
       for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1]; ++k) {
-        const uint32_t i = nb.index[k];
-        if (!isWater(p.phase[i]) || s.lambda[i] == 0.0f) continue;
-        const Vec3 r = p.xPred[i] - p.xPred[b];
-        kernel.set(pairRadius(p.radius[i], p.radius[b]));
-        dx -= p.mass[i] * s.lambda[i] * kernel.spikyGrad(r);
-        ++pushing;
+        const uint32_t i = index[k];
+        const bool push = phase[i] == kWaterPhase && L[i] != 0.0f;
+        const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
+        const PairKernel kern = pairKernel(0.5f * (H[i] + hb));
+        const float f = push ? p.mass[i] * L[i] * spikyFactorOf(kern, rx * rx + ry * ry + rz * rz) : 0.0f;
+        dx -= f * rx;
+        dy -= f * ry;
+        dz -= f * rz;
+        pushing += push ? 1 : 0;
       }
       // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
       // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
-      if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * dx;
+      if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * Vec3(dx, dy, dz);
     });
     parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
       if (i >= nc || p.invMass[i] != 0.0f) p.xPred[i] += s.delta[i];
@@ -166,39 +207,61 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   std::vector<Vec3>& vNew = s.delta;  // the solver's corrections are spent: reuse their memory
   vNew.resize(n);
   s.vorticity.resize(n);
+  const float* X = p.xPred[0].data();
+  const float* V = p.v[0].data();
+  const float* H = p.radius.data();
+  const float* M = p.mass.data();
+  const float* D = s.density.data();
+  const int32_t* phase = p.phase.data();
+  const uint32_t* index = nb.index.data();
   // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), and XSPH (Eq. 17) weighted by V_ij
   parallelFor(nw, [&](int64_t w) {
     const size_t i = static_cast<size_t>(nc + w);
-    const Vec3 vi = p.v[i];
-    Vec3 omega = Vec3::Zero(), blend = Vec3::Zero();
-    KernelCache kernel;
+    const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
+    const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
+    float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
+#pragma omp simd reduction(+ : bx, by, bz, ox, oy, oz)
     for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
-      const uint32_t j = nb.index[k];
-      if (!isWater(p.phase[j])) continue;
-      const Vec3 r = p.xPred[i] - p.xPred[j];
-      kernel.set(pairRadius(p.radius[i], p.radius[j]));
+      const uint32_t j = index[k];
+      const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+      const float r2 = rx * rx + ry * ry + rz * rz;
+      const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
       // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
-      const float vol = 2.0f * p.mass[j] / std::max(s.density[i] + s.density[j], 1e-3f);
-      const Vec3 vij = p.v[j] - vi;
-      blend += vol * kernel.poly6(r.squaredNorm()) * vij;
-      omega += vol * vij.cross(kernel.spikyGrad(r));
+      const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
+      const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
+      const float wgt = vol * poly6Of(kern, r2);
+      bx += wgt * vx;
+      by += wgt * vy;
+      bz += wgt * vz;
+      const float f = vol * spikyFactorOf(kern, r2);  // v_ij x (f r)
+      ox += f * (vy * rz - vz * ry);
+      oy += f * (vz * rx - vx * rz);
+      oz += f * (vx * ry - vy * rx);
     }
-    s.vorticity[i] = omega;
-    vNew[i] = vi + wp.viscosity * blend;
+    s.vorticity[i] = Vec3(ox, oy, oz);
+    vNew[i] = Vec3(vxi, vyi, vzi) + wp.viscosity * Vec3(bx, by, bz);
   });
   if (wp.vorticity > 0.0f) {
     // f = epsilon (N x omega), N = eta / |eta|, eta = grad |omega| (Macklin 2013 Eq. 16)
+    s.vorticityNorm.resize(n);
+    parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.vorticityNorm[j] = j < nc ? 0.0f : s.vorticity[j].norm(); });
+    const float* O = s.vorticityNorm.data();
     parallelFor(nw, [&](int64_t w) {
       const size_t i = static_cast<size_t>(nc + w);
-      Vec3 eta = Vec3::Zero();
-      KernelCache kernel;
+      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i];
+      float ex = 0.0f, ey = 0.0f, ez = 0.0f;
+#pragma omp simd reduction(+ : ex, ey, ez)
       for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
-        const uint32_t j = nb.index[k];
-        if (!isWater(p.phase[j])) continue;
-        const float vol = p.mass[j] / std::max(s.density[j], 1e-3f);
-        kernel.set(pairRadius(p.radius[i], p.radius[j]));
-        eta += vol * s.vorticity[j].norm() * kernel.spikyGrad(p.xPred[i] - p.xPred[j]);
+        const uint32_t j = index[k];
+        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+        const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
+        const float vol = phase[j] == kWaterPhase ? M[j] / std::max(D[j], 1e-3f) : 0.0f;
+        const float f = vol * O[j] * spikyFactorOf(kern, rx * rx + ry * ry + rz * rz);
+        ex += f * rx;
+        ey += f * ry;
+        ez += f * rz;
       }
+      const Vec3 eta(ex, ey, ez);
       const float len = eta.norm();
       if (len > 1e-9f) vNew[i] += dt * wp.vorticity * (eta / len).cross(s.vorticity[i]);
     });

@@ -18,6 +18,8 @@ struct FluidScratch {
   std::vector<float> lambda;       // m^2, lambda_i / m_i of the density constraint
   std::vector<Vec3> delta;         // m, position corrections of the current iteration; m/s, velocities after XSPH
   std::vector<Vec3> vorticity;     // 1/s, omega_i
+  std::vector<float> vorticityNorm; // 1/s, |omega_i| (0 for cloth)
+  std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
 };

@@ -119,7 +119,7 @@ void readWater(ObjectReader r, WaterParams& w) {
   ObjectReader t = r.object("tensile");
   w.tensileK = t.number("k", d.tensileK, Range::nonNegative());
   w.tensileDq = t.number("dq", d.tensileDq, Range{0.0, 1.0, false, true});
-  w.tensileN = t.integer("n", d.tensileN, Range::atLeast(1));
+  w.tensileN = t.integer("n", d.tensileN, Range::between(1, 32));  // the solver takes powers up to 63
   t.finish();
   w.boundaryFriction = r.number("boundaryFriction", d.boundaryFriction, Range::unit());
   r.finish();
