@@ -38,6 +38,7 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
 // scratch for the cloth solver (XPBD multipliers)
 struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
+  std::vector<float> correction;  // m, the moves of a colour's particles, 12 components per constraint (SoA)
   std::vector<Vec3> delta;
   std::vector<int> deltaCount;
 };

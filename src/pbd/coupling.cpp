@@ -58,14 +58,63 @@ float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const V
   return side * (xq - pt).dot(normal) - thickness;
 }
 
-uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb, CouplingScratch& s, bool rigidCloth) {
+void findCouplingCandidates(const Model& model, const Particles& p, const NeighborLists& nb, CouplingScratch& s) {
+  const int64_t nc = model.numCloth;
+  const int64_t n = static_cast<int64_t>(p.size());
+  const int64_t nw = n - nc;
+  s.candidateStart.assign(static_cast<size_t>(std::max<int64_t>(nw, 0)) + 1, 0);
+  s.candidates.clear();
+  if (nc == 0 || nw <= 0) return;
+  const int nThreads = omp_get_max_threads();
+  const size_t nTri = model.triangles.size();
+  s.seen.resize(static_cast<size_t>(nThreads));
+  s.perThreadCandidates.resize(static_cast<size_t>(nThreads));
+  std::vector<size_t> offset(static_cast<size_t>(nThreads) + 1, 0);
+  // each thread takes one contiguous range of water particles, in order, so concatenating the
+  // per-thread lists gives the candidates in water order for any thread count
+#pragma omp parallel num_threads(nThreads)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    std::vector<uint32_t>& seen = s.seen[static_cast<size_t>(t)];
+    std::vector<uint32_t>& out = s.perThreadCandidates[static_cast<size_t>(t)];
+    seen.assign(nTri, ~0u);
+    out.clear();
+    const int64_t begin = nw * t / nt, end = nw * (t + 1) / nt;
+    for (int64_t w = begin; w < end; ++w) {
+      const int64_t q = nc + w;
+      // the triangles around the cloth particles in q's neighbourhood, each once
+      for (uint32_t k = nb.start[q], kEnd = nb.clothEnd(q, static_cast<uint32_t>(nc)); k < kEnd; ++k) {
+        const uint32_t j = nb.index[k];
+        if (static_cast<int64_t>(j) >= nc) continue;
+        for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e) {
+          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[e]);
+          if (seen[tri] == static_cast<uint32_t>(q)) continue;
+          seen[tri] = static_cast<uint32_t>(q);
+          out.push_back(tri);
+        }
+      }
+      s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
+    }
+    offset[static_cast<size_t>(t) + 1] = out.size();
+#pragma omp barrier
+#pragma omp single
+    {
+      for (int u = 0; u < nt; ++u) offset[static_cast<size_t>(u) + 1] += offset[static_cast<size_t>(u)];
+      s.candidates.resize(offset[static_cast<size_t>(nt)]);
+    }
+    std::copy(out.begin(), out.end(), s.candidates.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(t)]));
+    for (int64_t w = begin; w < end; ++w)
+      s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(offset[static_cast<size_t>(t)]);
+  }
+}
+
+uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, bool rigidCloth) {
   const int64_t nc = model.numCloth;
   const int64_t n = static_cast<int64_t>(p.size());
   if (nc == 0 || n == nc) return 0;
   const int nThreads = omp_get_max_threads();
   const size_t nTri = model.triangles.size();
   s.perThread.resize(static_cast<size_t>(nThreads));
-  s.seen.resize(static_cast<size_t>(nThreads));
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
   // triangle normals once per pass, shared by every water particle that tests the triangle
@@ -86,57 +135,50 @@ uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     std::vector<CouplingContact>& out = s.perThread[static_cast<size_t>(t)];
-    std::vector<uint32_t>& seen = s.seen[static_cast<size_t>(t)];
-    seen.assign(nTri, ~0u);
     out.clear();
     const int64_t nw = n - nc;
     const int64_t begin = nc + nw * t / nt, end = nc + nw * (t + 1) / nt;
     for (int64_t q = begin; q < end; ++q) {
+      const uint32_t c0 = s.candidateStart[static_cast<size_t>(q - nc)], c1 = s.candidateStart[static_cast<size_t>(q - nc) + 1];
+      if (c0 == c1) continue;
       const float wq = p.invMass[q];
       const Vec3 xq0 = p.x[q];
       Vec3 dq = Vec3::Zero();
-      // candidate triangles: those around the cloth particles in q's neighbourhood, each once
-      for (uint32_t k = nb.start[q], kEnd = nb.clothEnd(q, static_cast<uint32_t>(nc)); k < kEnd; ++k) {
-        const uint32_t j = nb.index[k];
-        if (static_cast<int64_t>(j) >= nc) continue;
-        for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e) {
-          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[e]);
-          if (seen[tri] == static_cast<uint32_t>(q)) continue;
-          seen[tri] = static_cast<uint32_t>(q);
-          const auto& f = model.triangles[tri];
-          const Vec3& n0 = s.startNormal[tri];
-          const Vec3& n1 = s.normal[tri];
-          if (n0.isZero() || n1.isZero()) continue;
-          if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
-          // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
-          const float side = (xq0 - p.x[f[0]]).dot(n0) >= 0.0f ? 1.0f : -1.0f;
-          const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
-          const Vec3 xq = p.xPred[q] + dq;
-          // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
-          // triangles end here, before the closest point is needed
-          const float C = side * (xq - p.xPred[f[0]]).dot(n1) - thickness;
-          if (C >= 0.0f) continue;
-          Vec3 nrm, bary;
-          couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
-          // only a contact over the triangle's face (or one crossed from it) counts; far below or
-          // beside it is another triangle's business
-          const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
-          const Vec3 off = xq - pt;
-          const float along = std::fabs(off.dot(n1));
-          if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
-          if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
-          const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
-                      wc = rigidCloth ? 0.0f : p.invMass[f[2]];
-          const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
-          if (denom <= 0.0f) continue;
-          // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
-          const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
-          const float dl = -C / denom * kappa;
-          const Vec3 g = side * n1;
-          dq += wq * dl * g;
-          if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
-          else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
-        }
+      for (uint32_t c = c0; c < c1; ++c) {
+        const uint32_t tri = s.candidates[c];
+        const auto& f = model.triangles[tri];
+        const Vec3& n0 = s.startNormal[tri];
+        const Vec3& n1 = s.normal[tri];
+        if (n0.isZero() || n1.isZero()) continue;
+        if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
+        // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
+        const float side = (xq0 - p.x[f[0]]).dot(n0) >= 0.0f ? 1.0f : -1.0f;
+        const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
+        const Vec3 xq = p.xPred[q] + dq;
+        // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
+        // triangles end here, before the closest point is needed
+        const float C = side * (xq - p.xPred[f[0]]).dot(n1) - thickness;
+        if (C >= 0.0f) continue;
+        Vec3 nrm, bary;
+        couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
+        // only a contact over the triangle's face (or one crossed from it) counts; far below or
+        // beside it is another triangle's business
+        const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
+        const Vec3 off = xq - pt;
+        const float along = std::fabs(off.dot(n1));
+        if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
+        if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
+        const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
+                    wc = rigidCloth ? 0.0f : p.invMass[f[2]];
+        const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
+        if (denom <= 0.0f) continue;
+        // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
+        const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
+        const float dl = -C / denom * kappa;
+        const Vec3 g = side * n1;
+        dq += wq * dl * g;
+        if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
+        else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

@@ -19,6 +19,9 @@ struct CouplingContact {
 struct CouplingScratch {
   std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
+  std::vector<std::vector<uint32_t>> perThreadCandidates;
+  std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
+  std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep
   std::vector<Vec3> normal;                  // unit normal of each triangle at the predicted positions
   std::vector<Vec3> clothDelta;
@@ -39,10 +42,14 @@ inline float iterationFactor(float kappa, int iterations) {
   return 1.0f - std::pow(1.0f - kappa, 1.0f / static_cast<float>(iterations > 0 ? iterations : 1));
 }
 
-// one pass of the coupling constraint for every water particle against the cloth triangles near it.
+// the candidate triangles of every water particle: those around its cloth neighbours, each once, in
+// the order first met. Once per substep, before the passes of solveCoupling.
+void findCouplingCandidates(const Model& model, const Particles& p, const NeighborLists& nb, CouplingScratch& s);
+
+// one pass of the coupling constraint for every water particle against its candidate triangles.
 // p.x holds the positions at the start of the substep (the side each particle came from), p.xPred
 // the predicted ones. With rigidCloth the cloth is held still (a final pass that guarantees water
 // ends on its side). Returns the number of contacts.
-uint64_t solveCoupling(const Model& model, Particles& p, const NeighborLists& nb, CouplingScratch& s, bool rigidCloth);
+uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, bool rigidCloth);
 
 }  // namespace soak

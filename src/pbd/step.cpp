@@ -52,9 +52,10 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction
   ms.colliders += clock.lap();
   updateCouplingStiffness(model, state, ws.coupling.triangleStiffness);             // Eq. 22: wetter cloth lets water through
+  findCouplingCandidates(model, p, ws.neighbors, ws.coupling);                      // triangles near each water particle
   for (int it = 0; it < model.solver.couplingIterations; ++it)                     // water-cloth, Eq. 21-22
-    stats.couplingContacts += solveCoupling(model, p, ws.neighbors, ws.coupling, false);
-  solveCoupling(model, p, ws.neighbors, ws.coupling, true);                         // no water crosses the cloth
+    stats.couplingContacts += solveCoupling(model, p, ws.coupling, false);
+  solveCoupling(model, p, ws.coupling, true);                                       // no water crosses the cloth
   ms.coupling += clock.lap();
   updateVelocities(model, p, h);                                                    // v = (x* - x) / dt, damping
   addCouplingVelocity(model, p, ws.garment, h);                                     // implicit cloth pushed by water

@@ -144,6 +144,21 @@ TEST(ClothConstraint, BendAngleIsZeroWhenFlatAndSignedByFoldDirection) {
   EXPECT_NEAR(bendConstraint(a, b, c, Vec3(0.6f, -std::cos(3.0f), std::sin(3.0f)), 3.0f, g), 2 * kPi - 6.0f, 1e-4f);
 }
 
+TEST(ClothConstraint, BendAngleMatchesLibmAtan2AllRoundTheEdge) {
+  // the solver's polynomial atan2 against std::atan2 for folds in every octant, -pi to pi
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0.4f, 1, 0);
+  Vec3 g[4];
+  float worst = 0.0f;
+  for (int k = -1000; k <= 1000; ++k) {
+    const float t = 3.14f * static_cast<float>(k) / 1000.0f;
+    const Vec3 d(0.6f, -std::cos(t), std::sin(t));
+    const Vec3 n1 = (b - a).cross(c - a), n2 = (d - a).cross(b - a);
+    const float exact = std::atan2(n1.cross(n2).dot(b - a), n1.dot(n2));
+    worst = std::max(worst, std::abs(bendConstraint(a, b, c, d, 0.0f, g) - exact));
+  }
+  EXPECT_LT(worst, 2e-5f);
+}
+
 // a 0.5 m x 0.5 m horizontal sheet at 21 x 21, corners pinned, particles filled as the scene loader would
 struct Sheet {
   Model model;
