@@ -41,52 +41,55 @@ namespace {
   return y < 0.0f ? -r : r;
 }
 
-// plain 3-vectors for the vectorised loops (Eigen's copies of Vector3f stop GCC's vectoriser)
-struct V3 {
-  float x, y, z;
-};
-[[gnu::always_inline]] inline V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-[[gnu::always_inline]] inline V3 cross(V3 a, V3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-[[gnu::always_inline]] inline float dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-[[gnu::always_inline]] inline V3 scale(float s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-
-// the bend constraint, branch free (selects only) for the vectorised colour loop
-[[gnu::always_inline]] inline float bendValue(V3 a, V3 b, V3 c, V3 d, float restAngle, V3& g0, V3& g1, V3& g2, V3& g3) {
-  const V3 e = sub(b, a);
-  const float len2 = dot(e, e);
-  const V3 n1 = cross(e, sub(c, a));  // 2 * area1 * unit normal of (a, b, c)
-  const V3 n2 = cross(sub(d, a), e);  // 2 * area2 * unit normal of (b, a, d)
-  const float n1sq = dot(n1, n1), n2sq = dot(n2, n2);
-  const bool valid = (len2 >= 1e-20f) & (n1sq >= 1e-30f) & (n2sq >= 1e-30f);  // & not &&: no branch
-  const float z = valid ? 1.0f : 0.0f;
-  const float len = std::sqrt(std::max(len2, 1e-20f));
-  // both arguments carry the same factor |n1||n2|, which atan2 ignores
-  const float theta = fastAtan2(dot(cross(n1, n2), e) / len, dot(n1, n2));
-  const V3 gc = scale(-z * len / std::max(n1sq, 1e-30f), n1);
-  const V3 gd = scale(-z * len / std::max(n2sq, 1e-30f), n2);
-  const float sc = dot(sub(c, a), e) / std::max(len2, 1e-20f);  // where c projects on the edge, 0 at a and 1 at b
-  const float sd = dot(sub(d, a), e) / std::max(len2, 1e-20f);
-  const float ac = -(1.0f - sc), ad = -(1.0f - sd);
-  // component by component: a struct copy stops the vectoriser
-  g0.x = ac * gc.x + ad * gd.x;
-  g0.y = ac * gc.y + ad * gd.y;
-  g0.z = ac * gc.z + ad * gd.z;
-  g1.x = -sc * gc.x - sd * gd.x;
-  g1.y = -sc * gc.y - sd * gd.y;
-  g1.z = -sc * gc.z - sd * gd.z;
-  g2.x = gc.x;
-  g2.y = gc.y;
-  g2.z = gc.z;
-  g3.x = gd.x;
-  g3.y = gd.y;
-  g3.z = gd.z;
-  // the short way round, so a fold through +-pi does not unwind a whole turn
-  float C = theta - restAngle;
-  C -= (C > kPi ? 2.0f * kPi : 0.0f);
-  C += (C < -kPi ? 2.0f * kPi : 0.0f);
-  return z * C;
+// the bend constraint (Eq. 9) of constraints [begin, end): C_k to C[k], and gradient component c
+// (x, y, z of a, b, c, d) to G[c * stride + k]. Plain float locals only: under omp simd a struct or
+// a local whose address is taken becomes a per-lane array in memory, and the loop does not vectorise.
+// Gradients: the closed forms of Bridson et al. 2003 (a wing moves the angle by 1/height along the
+// normal; the edge vertices take the share that keeps the sum zero and rotations free).
+void bendKernel(int begin, int end, const int* __restrict I, const float* __restrict rest, const float* __restrict X,
+                float* __restrict Cout, float* __restrict G, int stride) {
+#pragma omp simd
+  for (int k = begin; k < end; ++k) {
+    const int i0 = I[4 * k], i1 = I[4 * k + 1], i2 = I[4 * k + 2], i3 = I[4 * k + 3];
+    const float ax = X[3 * i0], ay = X[3 * i0 + 1], az = X[3 * i0 + 2];
+    const float ex = X[3 * i1] - ax, ey = X[3 * i1 + 1] - ay, ez = X[3 * i1 + 2] - az;  // edge b - a
+    const float cx = X[3 * i2] - ax, cy = X[3 * i2 + 1] - ay, cz = X[3 * i2 + 2] - az;  // c - a
+    const float dx = X[3 * i3] - ax, dy = X[3 * i3 + 1] - ay, dz = X[3 * i3 + 2] - az;  // d - a
+    const float len2 = ex * ex + ey * ey + ez * ez;
+    // n1 = e x (c - a), n2 = (d - a) x e: 2 * area * unit normal of (a, b, c) and (b, a, d)
+    const float n1x = ey * cz - ez * cy, n1y = ez * cx - ex * cz, n1z = ex * cy - ey * cx;
+    const float n2x = dy * ez - dz * ey, n2y = dz * ex - dx * ez, n2z = dx * ey - dy * ex;
+    const float n1sq = n1x * n1x + n1y * n1y + n1z * n1z, n2sq = n2x * n2x + n2y * n2y + n2z * n2z;
+    const bool valid = (len2 >= 1e-20f) & (n1sq >= 1e-30f) & (n2sq >= 1e-30f);  // & not &&: no branch
+    const float z = valid ? 1.0f : 0.0f;
+    const float len = std::sqrt(std::max(len2, 1e-20f));
+    // theta = atan2((n1 x n2) . e / |e|, n1 . n2): both carry the factor |n1||n2|, which atan2 ignores
+    const float mx = n1y * n2z - n1z * n2y, my = n1z * n2x - n1x * n2z, mz = n1x * n2y - n1y * n2x;
+    const float theta = fastAtan2((mx * ex + my * ey + mz * ez) / len, n1x * n2x + n1y * n2y + n1z * n2z);
+    const float s1 = -z * len / std::max(n1sq, 1e-30f), s2 = -z * len / std::max(n2sq, 1e-30f);
+    const float gcx = s1 * n1x, gcy = s1 * n1y, gcz = s1 * n1z;
+    const float gdx = s2 * n2x, gdy = s2 * n2y, gdz = s2 * n2z;
+    const float sc = (cx * ex + cy * ey + cz * ez) / std::max(len2, 1e-20f);  // where c projects on the edge, 0 at a, 1 at b
+    const float sd = (dx * ex + dy * ey + dz * ez) / std::max(len2, 1e-20f);
+    const float ac = -(1.0f - sc), ad = -(1.0f - sd);
+    G[k] = ac * gcx + ad * gdx;
+    G[stride + k] = ac * gcy + ad * gdy;
+    G[2 * stride + k] = ac * gcz + ad * gdz;
+    G[3 * stride + k] = -sc * gcx - sd * gdx;
+    G[4 * stride + k] = -sc * gcy - sd * gdy;
+    G[5 * stride + k] = -sc * gcz - sd * gdz;
+    G[6 * stride + k] = gcx;
+    G[7 * stride + k] = gcy;
+    G[8 * stride + k] = gcz;
+    G[9 * stride + k] = gdx;
+    G[10 * stride + k] = gdy;
+    G[11 * stride + k] = gdz;
+    // the short way round, so a fold through +-pi does not unwind a whole turn
+    float C = theta - rest[k];
+    C -= (C > kPi ? 2.0f * kPi : 0.0f);
+    C += (C < -kPi ? 2.0f * kPi : 0.0f);
+    Cout[k] = z * C;
+  }
 }
 
 }  // namespace
@@ -97,10 +100,11 @@ struct V3 {
 // gradients are the closed forms of Bridson et al. 2003: a wing moves the angle by 1/height along the
 // normal, and the edge vertices take the share that keeps the sum zero and rotations free.
 float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, float restAngle, Vec3 grad[4]) {
-  V3 g[4];
-  const float C = bendValue({a.x(), a.y(), a.z()}, {b.x(), b.y(), b.z()}, {c.x(), c.y(), c.z()}, {d.x(), d.y(), d.z()},
-                            restAngle, g[0], g[1], g[2], g[3]);
-  for (int k = 0; k < 4; ++k) grad[k] = Vec3(g[k].x, g[k].y, g[k].z);
+  const float X[12] = {a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()};
+  const int I[4] = {0, 1, 2, 3};
+  float C, G[12];
+  bendKernel(0, 1, I, &restAngle, X, &C, G, 1);
+  for (int v = 0; v < 4; ++v) grad[v] = Vec3(G[3 * v], G[3 * v + 1], G[3 * v + 2]);
   return C;
 }
 
@@ -139,34 +143,33 @@ void stretchRange(int begin, int end, const int* __restrict I, const float* __re
 
 void bendRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
                const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
-               float* __restrict lambda, float* __restrict out, size_t strideSize) {
-  const int stride = static_cast<int>(strideSize);  // int indices throughout: the gathers take 32-bit offsets
+               float* __restrict lambda, float* __restrict out, float* __restrict C, size_t strideSize) {
+  const int stride = static_cast<int>(strideSize);
+  bendKernel(begin, end, I, rest, X, C, out, stride);
 #pragma omp simd
   for (int k = begin; k < end; ++k) {
     const int i0 = I[4 * k], i1 = I[4 * k + 1], i2 = I[4 * k + 2], i3 = I[4 * k + 3];
-    const float ax = X[3 * i0], ay = X[3 * i0 + 1], az = X[3 * i0 + 2];
-    const float bx = X[3 * i1], by = X[3 * i1 + 1], bz = X[3 * i1 + 2];
-    const float cx = X[3 * i2], cy = X[3 * i2 + 1], cz = X[3 * i2 + 2];
-    const float dx = X[3 * i3], dy = X[3 * i3 + 1], dz = X[3 * i3 + 2];
-    V3 g0, g1, g2, g3;
-    const float C = bendValue({ax, ay, az}, {bx, by, bz}, {cx, cy, cz}, {dx, dy, dz}, rest[k], g0, g1, g2, g3);  // Eq. 9
+    const float w0 = w[i0], w1 = w[i1], w2 = w[i2], w3 = w[i3];
+    float q0 = 0.0f, q1 = 0.0f, q2 = 0.0f, q3 = 0.0f;  // |grad_v C|^2
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+      q0 += out[c * stride + k] * out[c * stride + k];
+      q1 += out[(3 + c) * stride + k] * out[(3 + c) * stride + k];
+      q2 += out[(6 + c) * stride + k] * out[(6 + c) * stride + k];
+      q3 += out[(9 + c) * stride + k] * out[(9 + c) * stride + k];
+    }
     const float alpha = compliance[k] * invDt2;
-    const float denom = alpha + w[i0] * dot(g0, g0) + w[i1] * dot(g1, g1) + w[i2] * dot(g2, g2) + w[i3] * dot(g3, g3);
-    const float dl = denom > 0.0f ? (-C - alpha * lambda[k]) / std::max(denom, 1e-30f) : 0.0f;
+    const float denom = alpha + w0 * q0 + w1 * q1 + w2 * q2 + w3 * q3;
+    const float dl = denom > 0.0f ? (-C[k] - alpha * lambda[k]) / std::max(denom, 1e-30f) : 0.0f;
     lambda[k] += dl;
-    const float f0 = w[i0] * dl, f1 = w[i1] * dl, f2 = w[i2] * dl, f3 = w[i3] * dl;
-    out[k] = f0 * g0.x;
-    out[stride + k] = f0 * g0.y;
-    out[2 * stride + k] = f0 * g0.z;
-    out[3 * stride + k] = f1 * g1.x;
-    out[4 * stride + k] = f1 * g1.y;
-    out[5 * stride + k] = f1 * g1.z;
-    out[6 * stride + k] = f2 * g2.x;
-    out[7 * stride + k] = f2 * g2.y;
-    out[8 * stride + k] = f2 * g2.z;
-    out[9 * stride + k] = f3 * g3.x;
-    out[10 * stride + k] = f3 * g3.y;
-    out[11 * stride + k] = f3 * g3.z;
+    const float f0 = w0 * dl, f1 = w1 * dl, f2 = w2 * dl, f3 = w3 * dl;
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+      out[c * stride + k] *= f0;
+      out[(3 + c) * stride + k] *= f1;
+      out[(6 + c) * stride + k] *= f2;
+      out[(9 + c) * stride + k] *= f3;
+    }
   }
 }
 
@@ -183,6 +186,7 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   scratch.stretchLambda.assign(st.ids.size(), 0.0f);
   scratch.bendLambda.assign(bd.ids.size(), 0.0f);
   scratch.correction.resize(12 * std::max(st.ids.size(), bd.ids.size()));
+  scratch.bendC.resize(bd.ids.size());
   if (model.numCloth == 0 || dt <= 0.0f) return;
   const float invDt2 = 1.0f / (dt * dt);
   Vec3* x = p.xPred.data();
@@ -203,7 +207,7 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   };
   const auto bendColour = [&](int begin, int end) {
     bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
-              bendLambda, corr, stride);
+              bendLambda, corr, scratch.bendC.data(), stride);
     for (int k = begin; k < end; ++k)
       for (int v = 0; v < 4; ++v)
         x[bd.ids[k][v]] += Vec3(corr[(3 * v) * stride + k], corr[(3 * v + 1) * stride + k], corr[(3 * v + 2) * stride + k]);

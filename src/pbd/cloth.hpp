@@ -39,6 +39,7 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
 struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
   std::vector<float> correction;  // m, the moves of a colour's particles, 12 components per constraint (SoA)
+  std::vector<float> bendC;       // rad, C of each bend constraint of the colour being solved
   std::vector<Vec3> delta;
   std::vector<int> deltaCount;
 };
