@@ -120,6 +120,8 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   // triangle normals once per pass, shared by every water particle that tests the triangle
   s.startNormal.resize(nTri);
   s.normal.resize(nTri);
+  s.centroid.resize(nTri);
+  s.reach.resize(nTri);
   parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
     const auto& f = model.triangles[t];
     const Vec3 n0 = (p.x[f[1]] - p.x[f[0]]).cross(p.x[f[2]] - p.x[f[0]]);
@@ -127,6 +129,10 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
     const float l0 = n0.norm(), l1 = n1.norm();
     s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
     s.normal[t] = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
+    const Vec3 c = (p.xPred[f[0]] + p.xPred[f[1]] + p.xPred[f[2]]) / 3.0f;
+    s.centroid[t] = c;
+    s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
+                                     (p.xPred[f[2]] - c).squaredNorm()}));
   });
 
   // each thread takes one contiguous range of water particles, in order, so concatenating the
@@ -159,6 +165,11 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         // triangles end here, before the closest point is needed
         const float C = side * (xq - p.xPred[f[0]]).dot(n1) - thickness;
         if (C >= 0.0f) continue;
+        // the closest point must lie within d/2 of q's projection on the plane (below), and every
+        // point of the triangle is within reach of its centroid: a cheap test that rejects no contact
+        const Vec3 toC = xq - s.centroid[tri];
+        const float lateral = s.reach[tri] + 0.5f * thickness;
+        if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) continue;
         Vec3 nrm, bary;
         couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
         // only a contact over the triangle's face (or one crossed from it) counts; far below or

@@ -24,6 +24,8 @@ struct CouplingScratch {
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep
   std::vector<Vec3> normal;                  // unit normal of each triangle at the predicted positions
+  std::vector<Vec3> centroid;                // m, of each triangle at the predicted positions
+  std::vector<float> reach;                  // m, the farthest vertex from the centroid
   std::vector<Vec3> clothDelta;
   std::vector<uint32_t> clothCount;
   std::vector<float> triangleStiffness;   // kappa^couple per triangle (Eq. 22 drives it; 1 when dry)
