@@ -62,9 +62,12 @@ void findCouplingCandidates(const Model& model, const Particles& p, const Neighb
   const int64_t nc = model.numCloth;
   const int64_t n = static_cast<int64_t>(p.size());
   const int64_t nw = n - nc;
-  s.candidateStart.assign(static_cast<size_t>(std::max<int64_t>(nw, 0)) + 1, 0);
   s.candidates.clear();
-  if (nc == 0 || nw <= 0) return;
+  if (nc == 0 || nw <= 0) {  // no cloth: nothing to hold per water particle
+    s.candidateStart.clear();
+    return;
+  }
+  s.candidateStart.assign(static_cast<size_t>(nw) + 1, 0);
   const int nThreads = omp_get_max_threads();
   const size_t nTri = model.triangles.size();
   s.seen.resize(static_cast<size_t>(nThreads));
