@@ -45,6 +45,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
     return kd * viscosityLaplacian(r, pairRadius(p.radius[i], p.radius[j])) / rho0;
   };
   const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
+  const uint32_t cloth = static_cast<uint32_t>(nc);
   // nothing held, nothing to spread (the common case before the water arrives)
   bool any = false;
   for (int64_t i = 0; i < nc && !any; ++i) any = state.clothWater[i] > 0.0;
@@ -55,7 +56,15 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
     // sigma_i: the PBD step of i's constraint (Eq. 15-17) with the gradients of Eq. 16
     parallelFor(nc, [&](int64_t i) {
       float a = 0.0f, sq = 0.0f;
-      for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+      // sigma_i is read only by exchanges with a neighbour of another saturation: skip it otherwise
+      bool exchanges = false;
+      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end && !exchanges; ++e)
+        exchanges = samePiece(i, nb.index[e]) && sat[nb.index[e]] != sat[i];
+      if (!exchanges) {
+        s.sigma[i] = 0.0f;
+        return;
+      }
+      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
         const int64_t j = nb.index[e];
         if (!samePiece(i, j)) continue;
         float cosIJ;
@@ -68,7 +77,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
     // pairwise exchange, gathered per particle: the flow j -> i is bit for bit minus the flow i -> j
     parallelFor(nc, [&](int64_t i) {
       double dm = 0.0;
-      for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
         const int64_t j = nb.index[e];
         if (!samePiece(i, j)) continue;
         const double diff = static_cast<double>(sat[j]) - static_cast<double>(sat[i]);

@@ -85,13 +85,14 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   std::vector<float>& sat = state.clothSaturation;
   computeSaturation(model, state, s, sat);
   const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
+  const uint32_t cloth = static_cast<uint32_t>(nc);  // loops below read the cloth part of the lists
 
   // 2. Eq. 18: does gravity beat the pull of the wet neighbours above?
   s.transfers.assign(static_cast<size_t>(nc), 0);
   parallelFor(nc, [&](int64_t i) {
     if (state.clothBuffer[i] <= 0.0) return;
     Vec3 pull = Vec3::Zero();
-    for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+    for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {
       const int64_t j = nb.index[e];
       if (!samePiece(i, j)) continue;
       const float cosIJ = cosGravity(p.x[i], p.x[j], g);
@@ -114,7 +115,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     parallelFor(nc, [&](int64_t u) {
       if (!s.transfers[u]) return;
       double out = 0.0;
-      for (uint32_t e = nb.start[u]; e < nb.start[u + 1]; ++e) {
+      for (uint32_t e = nb.start[u], end = nb.clothEnd(u, cloth); e < end; ++e) {
         const int64_t l = nb.index[e];
         if (!samePiece(u, l)) continue;
         const float cosLU = cosGravity(p.x[l], p.x[u], g);
@@ -127,9 +128,10 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     s.delta.resize(static_cast<size_t>(nc));
     parallelFor(nc, [&](int64_t k) {
       double d = 0.0;
-      for (uint32_t e = nb.start[k]; e < nb.start[k + 1]; ++e) {
+      for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end; ++e) {
         const int64_t j = nb.index[e];
         if (!samePiece(k, j)) continue;
+        if (!s.transfers[j] && !s.transfers[k]) continue;  // neither sheds water: no flow either way
         const float cosKJ = cosGravity(p.x[k], p.x[j], g);  // > 0: k below j; cos theta_jk is exactly -cosKJ
         const float r2 = (p.x[k] - p.x[j]).squaredNorm();
         if (cosKJ > 0.0f && s.transfers[j])

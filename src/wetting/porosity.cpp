@@ -16,7 +16,7 @@ void clothVolumes(const Model& model, const std::vector<Vec3>& x, const std::vec
   parallelFor(nc, [&](int64_t i) {
     const float hi = radius[i];
     float sum = poly6(0.0f, hi);  // k includes i itself (NOTES.md on Eq. 10)
-    for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+    for (uint32_t k = nb.start[i], end = nb.clothEnd(i, static_cast<uint32_t>(nc)); k < end; ++k) {
       const uint32_t j = nb.index[k];
       if (static_cast<int64_t>(j) >= nc || phase[j] != phase[i]) continue;  // same piece only
       sum += poly6((x[i] - x[j]).squaredNorm(), pairRadius(hi, radius[j]));
