@@ -106,7 +106,8 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
 
 size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,
                          std::vector<uint8_t>& keep, double time) {
-  if (state.clothWetStart.size() != static_cast<size_t>(model.numCloth)) return 0;
+  // no cloth, or no piece wetted by contact (clothWetStart is then empty)
+  if (model.numCloth == 0 || state.clothWetStart.size() != static_cast<size_t>(model.numCloth)) return 0;
   Particles& p = state.particles;
   const int64_t nc = model.numCloth;
   const float now = static_cast<float>(time);
