@@ -97,8 +97,7 @@ void bendKernel(int begin, int end, const int* __restrict I, const float* __rest
 // C = theta(a, b, c, d) - phi0 (Eq. 9), theta the signed dihedral angle between triangles (a, b, c) and
 // (b, a, d): 0 when flat, positive when the wings fold towards -n (n the normal of (a, b, c)).
 // departs from Eq. 9's acos: atan2(sin, cos) is signed and well conditioned near 0 and pi, where acos' slope blows up.
-// gradients are the closed forms of Bridson et al. 2003: a wing moves the angle by 1/height along the
-// normal, and the edge vertices take the share that keeps the sum zero and rotations free.
+// One constraint through bendKernel, the solver's own code (for tests and callers outside the solver).
 float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, float restAngle, Vec3 grad[4]) {
   const float X[12] = {a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()};
   const int I[4] = {0, 1, 2, 3};
@@ -107,7 +106,6 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
   for (int v = 0; v < 4; ++v) grad[v] = Vec3(G[3 * v], G[3 * v + 1], G[3 * v + 2]);
   return C;
 }
-
 
 namespace {
 
