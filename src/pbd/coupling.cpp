@@ -68,8 +68,16 @@ void findCouplingCandidates(const Model& model, const Particles& p, const Neighb
     return;
   }
   s.candidateStart.assign(static_cast<size_t>(nw) + 1, 0);
-  const int nThreads = omp_get_max_threads();
   const size_t nTri = model.triangles.size();
+  // the triangles' normals at the start of the substep: p.x does not change during the passes
+  s.startNormal.resize(nTri);
+  parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
+    const auto& f = model.triangles[t];
+    const Vec3 n0 = (p.x[f[1]] - p.x[f[0]]).cross(p.x[f[2]] - p.x[f[0]]);
+    const float l0 = n0.norm();
+    s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
+  });
+  const int nThreads = omp_get_max_threads();
   s.seen.resize(static_cast<size_t>(nThreads));
   s.perThreadCandidates.resize(static_cast<size_t>(nThreads));
   std::vector<size_t> offset(static_cast<size_t>(nThreads) + 1, 0);
@@ -93,7 +101,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, const Neighb
           const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[e]);
           if (seen[tri] == static_cast<uint32_t>(q)) continue;
           seen[tri] = static_cast<uint32_t>(q);
-          out.push_back(tri);
+          if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
         }
       }
       s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
@@ -109,6 +117,16 @@ void findCouplingCandidates(const Model& model, const Particles& p, const Neighb
     for (int64_t w = begin; w < end; ++w)
       s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(offset[static_cast<size_t>(t)]);
   }
+  // the side each water particle came from: its start position against the triangle at the start
+  // (Eq. 21's sign), the same for every pass
+  s.candidateSide.resize(s.candidates.size());
+  parallelFor(nw, [&](int64_t w) {
+    const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
+    for (uint32_t c = s.candidateStart[static_cast<size_t>(w)]; c < s.candidateStart[static_cast<size_t>(w) + 1]; ++c) {
+      const auto& f = model.triangles[s.candidates[c]];
+      s.candidateSide[c] = (xq0 - p.x[f[0]]).dot(s.startNormal[s.candidates[c]]) >= 0.0f ? 1.0f : -1.0f;
+    }
+  });
 }
 
 uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, bool rigidCloth) {
@@ -121,16 +139,13 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
   // triangle normals once per pass, shared by every water particle that tests the triangle
-  s.startNormal.resize(nTri);
   s.normal.resize(nTri);
   s.centroid.resize(nTri);
   s.reach.resize(nTri);
   parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
     const auto& f = model.triangles[t];
-    const Vec3 n0 = (p.x[f[1]] - p.x[f[0]]).cross(p.x[f[2]] - p.x[f[0]]);
     const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
-    const float l0 = n0.norm(), l1 = n1.norm();
-    s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
+    const float l1 = n1.norm();
     s.normal[t] = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
     const Vec3 c = (p.xPred[f[0]] + p.xPred[f[1]] + p.xPred[f[2]]) / 3.0f;
     s.centroid[t] = c;
@@ -156,12 +171,10 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       for (uint32_t c = c0; c < c1; ++c) {
         const uint32_t tri = s.candidates[c];
         const auto& f = model.triangles[tri];
-        const Vec3& n0 = s.startNormal[tri];
         const Vec3& n1 = s.normal[tri];
-        if (n0.isZero() || n1.isZero()) continue;
+        if (n1.isZero()) continue;
         if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
-        // the side q came from: its start position against the triangle at the start (Eq. 21's sign)
-        const float side = (xq0 - p.x[f[0]]).dot(n0) >= 0.0f ? 1.0f : -1.0f;
+        const float side = s.candidateSide[c];
         const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
         const Vec3 xq = p.xPred[q] + dq;
         // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most

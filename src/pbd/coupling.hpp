@@ -22,7 +22,8 @@ struct CouplingScratch {
   std::vector<std::vector<uint32_t>> perThreadCandidates;
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
-  std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep
+  std::vector<float> candidateSide;          // +-1: the side of each candidate the particle came from
+  std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep (0: degenerate)
   std::vector<Vec3> normal;                  // unit normal of each triangle at the predicted positions
   std::vector<Vec3> centroid;                // m, of each triangle at the predicted positions
   std::vector<float> reach;                  // m, the farthest vertex from the centroid
@@ -45,7 +46,7 @@ inline float iterationFactor(float kappa, int iterations) {
 }
 
 // the candidate triangles of every water particle: those around its cloth neighbours, each once, in
-// the order first met. Once per substep, before the passes of solveCoupling.
+// the order first met, and the side it came from. Once per substep, before the passes of solveCoupling.
 void findCouplingCandidates(const Model& model, const Particles& p, const NeighborLists& nb, CouplingScratch& s);
 
 // one pass of the coupling constraint for every water particle against its candidate triangles.
