@@ -41,6 +41,21 @@ Vec3 closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3&
   return {1 - v - w, v, w};
 }
 
+// how far outside a triangle (in barycentric units) a point still counts as on its face
+constexpr float kFaceTolerance = 1e-3f;
+// the most sweeps of the rigid pass over a particle's candidates
+constexpr int kRigidSweeps = 4;
+
+// barycentric weights of x (a point in the plane) on the plane of triangle (a, b, c); negative outside it
+Vec3 planeBarycentric(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e0 = b - a, e1 = c - a, e2 = x - a;
+  const float d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1), d20 = e2.dot(e0), d21 = e2.dot(e1);
+  const float denom = d00 * d11 - d01 * d01;
+  if (denom <= 0.0f) return {-1, -1, -1};
+  const float v = (d11 * d20 - d01 * d21) / denom, w = (d00 * d21 - d01 * d20) / denom;
+  return {1 - v - w, v, w};
+}
+
 }  // namespace
 
 float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const Vec3& xc, float side, float thickness,
@@ -58,7 +73,7 @@ float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const V
   return side * (xq - pt).dot(normal) - thickness;
 }
 
-void findCouplingCandidates(const Model& model, const Particles& p, const NeighborLists& nb, CouplingScratch& s) {
+void findCouplingCandidates(const Model& model, const Particles& p, CouplingScratch& s) {
   const int64_t nc = model.numCloth;
   const int64_t n = static_cast<int64_t>(p.size());
   const int64_t nw = n - nc;
@@ -77,8 +92,24 @@ void findCouplingCandidates(const Model& model, const Particles& p, const Neighb
     const float l0 = n0.norm();
     s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
   });
+  // a grid of the cloth alone at its predicted positions (the solvers have moved them since the
+  // neighbour search), and the box around the sheet that a path must touch to meet it
+  s.clothPos.assign(p.xPred.begin(), p.xPred.begin() + nc);
+  float hCloth = 0.0f;
+  Vec3 lo = s.clothPos[0], hi = s.clothPos[0];
+  for (int64_t j = 0; j < nc; ++j) {
+    hCloth = std::max(hCloth, p.radius[j]);
+    lo = lo.cwiseMin(s.clothPos[j]);
+    hi = hi.cwiseMax(s.clothPos[j]);
+  }
+  const float cell = std::max(hCloth, model.water.supportRadius);
+  buildGrid(s.clothPos, cell, s.clothGrid);
+  lo.array() -= cell;
+  hi.array() += cell;
+  const NeighborGrid& grid = s.clothGrid;
   const int nThreads = omp_get_max_threads();
   s.seen.resize(static_cast<size_t>(nThreads));
+  s.seenCloth.resize(static_cast<size_t>(nThreads));
   s.perThreadCandidates.resize(static_cast<size_t>(nThreads));
   std::vector<size_t> offset(static_cast<size_t>(nThreads) + 1, 0);
   // each thread takes one contiguous range of water particles, in order, so concatenating the
@@ -87,22 +118,45 @@ void findCouplingCandidates(const Model& model, const Particles& p, const Neighb
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     std::vector<uint32_t>& seen = s.seen[static_cast<size_t>(t)];
+    std::vector<uint32_t>& seenCloth = s.seenCloth[static_cast<size_t>(t)];
     std::vector<uint32_t>& out = s.perThreadCandidates[static_cast<size_t>(t)];
     seen.assign(nTri, ~0u);
+    seenCloth.assign(static_cast<size_t>(nc), ~0u);
     out.clear();
     const int64_t begin = nw * t / nt, end = nw * (t + 1) / nt;
     for (int64_t w = begin; w < end; ++w) {
       const int64_t q = nc + w;
-      // the triangles around the cloth particles in q's neighbourhood, each once
-      for (uint32_t k = nb.start[q], kEnd = nb.clothEnd(q, static_cast<uint32_t>(nc)); k < kEnd; ++k) {
-        const uint32_t j = nb.index[k];
-        if (static_cast<int64_t>(j) >= nc) continue;
-        for (int e = model.vertexTriangleStart[j]; e < model.vertexTriangleStart[j + 1]; ++e) {
-          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[e]);
-          if (seen[tri] == static_cast<uint32_t>(q)) continue;
-          seen[tri] = static_cast<uint32_t>(q);
-          if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
-        }
+      const Vec3 a = p.x[q], ab = p.xPred[q] - a;
+      const float reach = std::min(0.5f * (p.radius[q] + hCloth), cell);
+      const bool nearSheet = (a.cwiseMin(p.xPred[q]).array() <= hi.array()).all() &&
+                             (a.cwiseMax(p.xPred[q]).array() >= lo.array()).all();
+      // the path in pieces no longer than a cell, each piece's box of cells (at most 4 per axis)
+      const float len2 = ab.squaredNorm();
+      const int pieces = nearSheet ? std::max(1, static_cast<int>(std::ceil(std::sqrt(len2) / cell))) : 0;
+      for (int k = 0; k < pieces; ++k) {
+        const Vec3 p0 = a + ab * (static_cast<float>(k) / pieces), p1 = a + ab * (static_cast<float>(k + 1) / pieces);
+        const Eigen::Vector3i c0 = grid.cellOf(Vec3(p0.cwiseMin(p1).array() - reach)),
+                              c1 = grid.cellOf(Vec3(p0.cwiseMax(p1).array() + reach));
+        for (int cz = c0.z(); cz <= c1.z(); ++cz)
+          for (int cy = c0.y(); cy <= c1.y(); ++cy)
+            for (int cx = c0.x(); cx <= c1.x(); ++cx) {
+              const uint32_t b = grid.bucketOf({cx, cy, cz});
+              for (uint32_t e = grid.cellStart[b]; e < grid.cellStart[b + 1]; ++e) {
+                const uint32_t j = grid.cellEntries[e];
+                if (seenCloth[j] == static_cast<uint32_t>(q)) continue;
+                seenCloth[j] = static_cast<uint32_t>(q);
+                // distance from cloth particle j to the path
+                const Vec3 aj = s.clothPos[j] - a;
+                const float u = len2 > 0.0f ? std::clamp(aj.dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
+                if ((aj - u * ab).squaredNorm() >= reach * reach) continue;
+                for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
+                  const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
+                  if (seen[tri] == static_cast<uint32_t>(q)) continue;
+                  seen[tri] = static_cast<uint32_t>(q);
+                  if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
+                }
+              }
+            }
       }
       s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
     }
@@ -168,6 +222,10 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       const float wq = p.invMass[q];
       const Vec3 xq0 = p.x[q];
       Vec3 dq = Vec3::Zero();
+      // the rigid pass sweeps the candidates again, for paths through a face only, while it still
+      // moves q: in a crumpled sheet the correction of one triangle can push q through another
+      for (int sweep = 0, sweeps = rigidCloth ? kRigidSweeps : 1; sweep < sweeps; ++sweep) {
+      bool moved = false;
       for (uint32_t c = c0; c < c1; ++c) {
         const uint32_t tri = s.candidates[c];
         const auto& f = model.triangles[tri];
@@ -179,22 +237,43 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const Vec3 xq = p.xPred[q] + dq;
         // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
         // triangles end here, before the closest point is needed
-        const float C = side * (xq - p.xPred[f[0]]).dot(n1) - thickness;
+        const float dist = side * (xq - p.xPred[f[0]]).dot(n1);
+        // a later sweep only needs q back on its side: a fold narrower than 2d cannot hold it d from both
+        const float C = dist - (sweep == 0 ? thickness : 0.25f * thickness);
         if (C >= 0.0f) continue;
-        // the closest point must lie within d/2 of q's projection on the plane (below), and every
-        // point of the triangle is within reach of its centroid: a cheap test that rejects no contact
-        const Vec3 toC = xq - s.centroid[tri];
-        const float lateral = s.reach[tri] + 0.5f * thickness;
-        if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) continue;
-        Vec3 nrm, bary;
-        couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
-        // only a contact over the triangle's face (or one crossed from it) counts; far below or
-        // beside it is another triangle's business
-        const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
-        const Vec3 off = xq - pt;
-        const float along = std::fabs(off.dot(n1));
-        if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
-        if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
+        Vec3 bary;
+        bool contact = false;
+        // a path through the face: q started on its side of the plane and is now behind it, and the
+        // point where its path met the plane lies on the triangle. Found wherever q ended up, so a
+        // particle faster than h per step cannot pass the sheet (a departure from the closest-point
+        // test alone, docs/models.md on Eq. 21)
+        if (dist < 0.0f) {
+          const float before = side * (xq0 - p.xPred[f[0]]).dot(n1);
+          if (before > 0.0f) {
+            const Vec3 hit = xq0 + (before / (before - dist)) * (xq - xq0);
+            bary = planeBarycentric(hit, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]]);
+            contact = bary.minCoeff() >= -kFaceTolerance;
+            if (contact) bary = bary.cwiseMax(0.0f) / bary.cwiseMax(0.0f).sum();
+          }
+        }
+        if (!contact) {
+          if (sweep > 0) continue;
+          // Eq. 21 near the face: the closest point must lie within d/2 of q's projection on the plane
+          // (below), and every point of the triangle is within reach of its centroid: a cheap test
+          // that rejects no contact
+          const Vec3 toC = xq - s.centroid[tri];
+          const float lateral = s.reach[tri] + 0.5f * thickness;
+          if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) continue;
+          Vec3 nrm;
+          couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
+          // only a contact over the triangle's face counts; far below or beside it is another
+          // triangle's business
+          const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
+          const Vec3 off = xq - pt;
+          const float along = std::fabs(off.dot(n1));
+          if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
+          if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
+        }
         const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
                     wc = rigidCloth ? 0.0f : p.invMass[f[2]];
         const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
@@ -204,8 +283,11 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const float dl = -C / denom * kappa;
         const Vec3 g = side * n1;
         dq += wq * dl * g;
+        moved = true;
         if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
         else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
+      }
+      if (!moved) break;
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

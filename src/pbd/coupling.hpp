@@ -19,6 +19,9 @@ struct CouplingContact {
 struct CouplingScratch {
   std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
+  std::vector<std::vector<uint32_t>> seenCloth;  // per thread: the water particle that last tested a cloth particle
+  std::vector<Vec3> clothPos;                // m, the cloth's predicted positions the cloth grid was built on
+  NeighborGrid clothGrid;                    // the cloth particles alone, for the water's paths
   std::vector<std::vector<uint32_t>> perThreadCandidates;
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
@@ -45,9 +48,11 @@ inline float iterationFactor(float kappa, int iterations) {
   return 1.0f - std::pow(1.0f - kappa, 1.0f / static_cast<float>(iterations > 0 ? iterations : 1));
 }
 
-// the candidate triangles of every water particle: those around its cloth neighbours, each once, in
-// the order first met, and the side it came from. Once per substep, before the passes of solveCoupling.
-void findCouplingCandidates(const Model& model, const Particles& p, const NeighborLists& nb, CouplingScratch& s);
+// the candidate triangles of every water particle: those around the cloth particles within reach of
+// its path this substep (the segment from x to x*, so a particle fast enough to pass the sheet in one
+// step still meets it), each once, in the order first met, and the side it came from. Once per
+// substep, after the solvers have moved x* and before the passes of solveCoupling.
+void findCouplingCandidates(const Model& model, const Particles& p, CouplingScratch& s);
 
 // one pass of the coupling constraint for every water particle against its candidate triangles.
 // p.x holds the positions at the start of the substep (the side each particle came from), p.xPred

@@ -52,7 +52,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction
   ms.colliders += clock.lap();
   updateCouplingStiffness(model, state, ws.coupling.triangleStiffness);             // Eq. 22: wetter cloth lets water through
-  findCouplingCandidates(model, p, ws.neighbors, ws.coupling);                      // triangles near each water particle
+  findCouplingCandidates(model, p, ws.coupling);                                    // triangles near each water particle's path
   for (int it = 0; it < model.solver.couplingIterations; ++it)                     // water-cloth, Eq. 21-22
     stats.couplingContacts += solveCoupling(model, p, ws.coupling, false);
   solveCoupling(model, p, ws.coupling, true);                                       // no water crosses the cloth
