@@ -225,69 +225,68 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       // the rigid pass sweeps the candidates again, for paths through a face only, while it still
       // moves q: in a crumpled sheet the correction of one triangle can push q through another
       for (int sweep = 0, sweeps = rigidCloth ? kRigidSweeps : 1; sweep < sweeps; ++sweep) {
-      bool moved = false;
-      for (uint32_t c = c0; c < c1; ++c) {
-        const uint32_t tri = s.candidates[c];
-        const auto& f = model.triangles[tri];
-        const Vec3& n1 = s.normal[tri];
-        if (n1.isZero()) continue;
-        if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
-        const float side = s.candidateSide[c];
-        const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
-        const Vec3 xq = p.xPred[q] + dq;
-        // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
-        // triangles end here, before the closest point is needed
-        const float dist = side * (xq - p.xPred[f[0]]).dot(n1);
-        // a later sweep only needs q back on its side: a fold narrower than 2d cannot hold it d from both
-        const float C = dist - (sweep == 0 ? thickness : 0.25f * thickness);
-        if (C >= 0.0f) continue;
-        Vec3 bary;
-        bool contact = false;
-        // a path through the face: q started on its side of the plane and is now behind it, and the
-        // point where its path met the plane lies on the triangle. Found wherever q ended up, so a
-        // particle faster than h per step cannot pass the sheet (a departure from the closest-point
-        // test alone, docs/models.md on Eq. 21)
-        if (dist < 0.0f) {
-          const float before = side * (xq0 - p.xPred[f[0]]).dot(n1);
-          if (before > 0.0f) {
-            const Vec3 hit = xq0 + (before / (before - dist)) * (xq - xq0);
-            bary = planeBarycentric(hit, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]]);
-            contact = bary.minCoeff() >= -kFaceTolerance;
-            if (contact) bary = bary.cwiseMax(0.0f) / bary.cwiseMax(0.0f).sum();
+        bool moved = false;
+        for (uint32_t c = c0; c < c1; ++c) {
+          const uint32_t tri = s.candidates[c];
+          const auto& f = model.triangles[tri];
+          const Vec3& n1 = s.normal[tri];
+          if (n1.isZero()) continue;
+          if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
+          const float side = s.candidateSide[c];
+          const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
+          const Vec3 xq = p.xPred[q] + dq;
+          // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
+          // triangles end here, before the closest point is needed
+          const float dist = side * (xq - p.xPred[f[0]]).dot(n1);
+          // a later sweep only needs q back on its side: a fold narrower than 2d cannot hold it d from both
+          const float C = dist - (sweep == 0 ? thickness : 0.25f * thickness);
+          if (C >= 0.0f) continue;
+          Vec3 bary;
+          bool contact = false;
+          // a path through the face: q started on its side of the plane and is now behind it, and the
+          // point where its path met the plane lies on the triangle. Found wherever q ended up, so a
+          // particle faster than h per step cannot pass the sheet (a departure from the closest-point
+          // test alone, docs/models.md on Eq. 21)
+          if (dist < 0.0f) {
+            const float before = side * (xq0 - p.xPred[f[0]]).dot(n1);
+            if (before > 0.0f) {
+              const Vec3 hit = xq0 + (before / (before - dist)) * (xq - xq0);
+              bary = planeBarycentric(hit, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]]);
+              contact = bary.minCoeff() >= -kFaceTolerance;
+              if (contact) bary = bary.cwiseMax(0.0f) / bary.cwiseMax(0.0f).sum();
+            }
           }
+          if (!contact) {
+            if (sweep > 0) continue;
+            // Eq. 21 near the face: the closest point must lie within d/2 of q's projection on the plane
+            // (below), and every point of the triangle is within reach of its centroid: a cheap test
+            // that rejects no contact
+            const Vec3 toC = xq - s.centroid[tri];
+            const float lateral = s.reach[tri] + 0.5f * thickness;
+            if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) continue;
+            Vec3 nrm;
+            couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
+            // only a contact over the triangle's face counts; far below or beside it is another
+            // triangle's business
+            const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
+            const Vec3 off = xq - pt;
+            const float along = std::fabs(off.dot(n1));
+            if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
+            if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
+          }
+          const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
+                      wc = rigidCloth ? 0.0f : p.invMass[f[2]];
+          const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
+          if (denom <= 0.0f) continue;
+          // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
+          const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
+          const float dl = -C / denom * kappa;
+          const Vec3 g = side * n1;
+          dq += wq * dl * g;
+          moved = true;
+          if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
         }
-        if (!contact) {
-          if (sweep > 0) continue;
-          // Eq. 21 near the face: the closest point must lie within d/2 of q's projection on the plane
-          // (below), and every point of the triangle is within reach of its centroid: a cheap test
-          // that rejects no contact
-          const Vec3 toC = xq - s.centroid[tri];
-          const float lateral = s.reach[tri] + 0.5f * thickness;
-          if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) continue;
-          Vec3 nrm;
-          couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
-          // only a contact over the triangle's face counts; far below or beside it is another
-          // triangle's business
-          const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
-          const Vec3 off = xq - pt;
-          const float along = std::fabs(off.dot(n1));
-          if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
-          if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
-        }
-        const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
-                    wc = rigidCloth ? 0.0f : p.invMass[f[2]];
-        const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
-        if (denom <= 0.0f) continue;
-        // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
-        const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
-        const float dl = -C / denom * kappa;
-        const Vec3 g = side * n1;
-        dq += wq * dl * g;
-        moved = true;
-        if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
-        else out.push_back({tri, Vec3::Zero(), Vec3::Zero(), Vec3::Zero()});
-      }
-      if (!moved) break;
+        if (!moved) break;
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

@@ -57,7 +57,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
 // one pass of the coupling constraint for every water particle against its candidate triangles.
 // p.x holds the positions at the start of the substep (the side each particle came from), p.xPred
 // the predicted ones. With rigidCloth the cloth is held still (a final pass that guarantees water
-// ends on its side). Returns the number of contacts.
+// ends on its side). Returns the number of contacts of a movable-cloth pass (0 for the rigid one).
 uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, bool rigidCloth);
 
 }  // namespace soak
