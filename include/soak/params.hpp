@@ -40,6 +40,7 @@ struct ClothMaterial {
   float thickness = 0.01f;          // m, d of Eq. 21 and the self-collision distance
   float friction = 0.3f;            // Coulomb-like friction against colliders, 0..1
   bool selfCollision = true;
+  float tetherSlack = 0.0f;         // fraction a particle may stray beyond its rest path length from the pins
 };
 
 // cloth wetting of Shao et al. 2017 section 4 (docs/models.md, "Wetting"). Saturations are

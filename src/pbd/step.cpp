@@ -45,8 +45,8 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
   solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
   ms.water += clock.lap();
-  solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // stretch Eq. 8, bend Eq. 9
-  solveTethers(model, p);                                                           // long range attachments
+  solveTethers(model, p);                                                           // long range attachments first,
+  solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // then stretch Eq. 8, bend Eq. 9
   clothSelfCollision(model, p, ws.neighbors, ws.cloth);
   ms.cloth += clock.lap();
   projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction

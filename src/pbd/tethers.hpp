@@ -6,7 +6,8 @@
 namespace soak {
 
 // rebuilds model.tethers from the pins and the stretch edges: each free particle is tied to up to
-// maxAnchors pinned particles of its piece, the nearest by shortest path along mesh edges
+// maxAnchors pinned particles of its piece, the nearest by shortest path over the rest shape (edges and
+// 2-ring chords), with length (1 + material.tetherSlack) times that path
 void buildTethers(Model& model, int maxAnchors = 4);
 
 // projects every free cloth particle back inside the spheres |x - x_anchor| <= length (the anchors

@@ -232,7 +232,7 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   const ClothMaterial d;
   ClothMaterial m;
   if (solver == ClothSolver::Implicit) {  // the KES laws, Rayleigh damping and wet friction replace these
-    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction"})
+    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction", "tetherSlack"})
       if (r.has(key))
         r.log().error(r.pathOf(key), fmt::format("expected no {} on a piece with \"solver\": \"implicit\" (a PBD "
                                                  "key; set the garment section instead, docs/scene-format.md)",
@@ -250,6 +250,7 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   m.thickness = r.number("thickness", d.thickness, Range::positive());
   m.friction = r.number("friction", d.friction, Range::unit());
   m.selfCollision = r.boolean("selfCollision", d.selfCollision) && solver == ClothSolver::Pbd;
+  m.tetherSlack = r.number("tetherSlack", d.tetherSlack, Range::nonNegative());
   r.finish();
   return m;
 }
