@@ -3,6 +3,7 @@
 #include "core/parallel.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <omp.h>
 
 namespace soak {
@@ -54,6 +55,28 @@ Vec3 planeBarycentric(const Vec3& x, const Vec3& a, const Vec3& b, const Vec3& c
   if (denom <= 0.0f) return {-1, -1, -1};
   const float v = (d11 * d20 - d01 * d21) / denom, w = (d00 * d21 - d01 * d20) / denom;
   return {1 - v - w, v, w};
+}
+
+// the sheet's normal at each cloth particle at the start of the substep: the area-weighted normals of
+// its triangles, summed again over its 1-ring (not normalised: only its direction is used)
+void smoothStartNormals(const Model& model, const Particles& p, CouplingScratch& s) {
+  const int64_t nc = model.numCloth;
+  s.vertexNormal.resize(static_cast<size_t>(nc));
+  s.sheetNormal.resize(static_cast<size_t>(nc));
+  parallelFor(nc, [&](int64_t v) {
+    Vec3 sum = Vec3::Zero();
+    for (int k = model.vertexTriangleStart[v]; k < model.vertexTriangleStart[v + 1]; ++k) {
+      const auto& f = model.triangles[static_cast<size_t>(model.vertexTriangles[k])];
+      sum += (p.x[f[1]] - p.x[f[0]]).cross(p.x[f[2]] - p.x[f[0]]);
+    }
+    s.vertexNormal[v] = sum;
+  });
+  parallelFor(nc, [&](int64_t v) {
+    Vec3 sum = s.vertexNormal[v];
+    for (int k = model.vertexNeighborStart[v]; k < model.vertexNeighborStart[v + 1]; ++k)
+      sum += s.vertexNormal[model.vertexNeighbors[k]];
+    s.sheetNormal[v] = sum;
+  });
 }
 
 }  // namespace
@@ -171,14 +194,32 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     for (int64_t w = begin; w < end; ++w)
       s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(offset[static_cast<size_t>(t)]);
   }
-  // the side each water particle came from: its start position against the triangle at the start
-  // (Eq. 21's sign), the same for every pass
+  // the side each water particle came from (Eq. 21's sign), the same for every pass. A triangle's own
+  // plane decides only where q started over its face: the plane of a triangle beside q, on a ridge or
+  // fold of a crumpled sheet, can pass on either side of q. Elsewhere q keeps the side of the sheet it
+  // is on: its side at the nearest cloth particle against the sheet's normal there, smoothed over two
+  // rings so that a small fold (a triangle turned over) does not flip it. The mesh's normals agree
+  // across the sheet, so one side holds for every triangle of a layer (docs/models.md on Eq. 21)
+  smoothStartNormals(model, p, s);
   s.candidateSide.resize(s.candidates.size());
   parallelFor(nw, [&](int64_t w) {
     const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
-    for (uint32_t c = s.candidateStart[static_cast<size_t>(w)]; c < s.candidateStart[static_cast<size_t>(w) + 1]; ++c) {
-      const auto& f = model.triangles[s.candidates[c]];
-      s.candidateSide[c] = (xq0 - p.x[f[0]]).dot(s.startNormal[s.candidates[c]]) >= 0.0f ? 1.0f : -1.0f;
+    const uint32_t c0 = s.candidateStart[static_cast<size_t>(w)], c1 = s.candidateStart[static_cast<size_t>(w) + 1];
+    float nearest2 = std::numeric_limits<float>::max();
+    int nearest = -1;
+    for (uint32_t c = c0; c < c1; ++c)
+      for (int v : model.triangles[s.candidates[c]]) {
+        const float d2 = (xq0 - p.x[v]).squaredNorm();
+        if (d2 < nearest2) nearest2 = d2, nearest = v;
+      }
+    const float sheetSide = nearest < 0 || (xq0 - p.x[nearest]).dot(s.sheetNormal[nearest]) >= 0.0f ? 1.0f : -1.0f;
+    for (uint32_t c = c0; c < c1; ++c) {
+      const uint32_t tri = s.candidates[c];
+      const auto& f = model.triangles[tri];
+      const Vec3& n0 = s.startNormal[tri];
+      const float dist = (xq0 - p.x[f[0]]).dot(n0);
+      const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
+      s.candidateSide[c] = over.minCoeff() >= -kFaceTolerance ? (dist >= 0.0f ? 1.0f : -1.0f) : sheetSide;
     }
   });
 }

@@ -27,6 +27,8 @@ struct CouplingScratch {
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
   std::vector<float> candidateSide;          // +-1: the side of each candidate the particle came from
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep (0: degenerate)
+  std::vector<Vec3> vertexNormal;            // per cloth particle: its triangles' area-weighted normals, summed
+  std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
   std::vector<Vec3> normal;                  // unit normal of each triangle at the predicted positions
   std::vector<Vec3> centroid;                // m, of each triangle at the predicted positions
   std::vector<float> reach;                  // m, the farthest vertex from the centroid
