@@ -11,4 +11,12 @@ namespace soak {
 // grows by their mass. Stops quietly at model.solver.maxParticles. Returns the number created.
 size_t emitWater(const Model& model, State& state, double t, float dt);
 
+// the SPH density (poly6, the particle itself included) of an endless cubic lattice of water particles
+// at this spacing, kg/m^3
+float latticeDensity(const WaterParams& w, float spacing);
+
+// the spacing at which that lattice has the rest density: where a block of water is laid out (Table 1's
+// 0.0082 kg at 0.02 m with h = 0.04 m sums to about 1035 kg/m^3, 3.5% compressed)
+float restLatticeSpacing(const WaterParams& w);
+
 }  // namespace soak

@@ -65,8 +65,9 @@ TEST(EmitterBlock, FillsTheBoxOnASpacingLattice) {
     EXPECT_FLOAT_EQ(s.particles.invMass[i], 1.0f / m.water.particleMass);
     EXPECT_FLOAT_EQ(s.particles.radius[i], m.water.supportRadius);
     EXPECT_EQ(s.particles.v[i], m.emitters[0].velocity);
-    // on the lattice boxMin + spacing (k + 1/2), inside the box
-    const Vec3 rel = (s.particles.x[i] - m.emitters[0].boxMin) / m.water.spacing - Vec3::Constant(0.5f);
+    // 5 sites a side (as many as fit at the spacing), at the rest spacing about the box's centre
+    const Vec3 centre = 0.5f * (m.emitters[0].boxMin + m.emitters[0].boxMax);
+    const Vec3 rel = (s.particles.x[i] - centre) / restLatticeSpacing(m.water) + Vec3::Constant(2.0f);
     std::array<long, 3> site{};
     for (int a = 0; a < 3; ++a) {
       site[a] = std::lround(rel[a]);
@@ -81,6 +82,17 @@ TEST(EmitterBlock, FillsTheBoxOnASpacingLattice) {
   // emitted once only
   EXPECT_EQ(emitWater(m, s, 0.01, 0.01f), 0u);
   EXPECT_EQ(s.particles.size(), 126u);
+}
+
+TEST(EmitterBlock, LaidOutAtTheSpacingOfRestDensity) {
+  const Model m = blockModel();
+  // Table 1's mass at its spacing sums to more than the rest density: a block laid out there starts
+  // compressed and flies apart
+  EXPECT_GT(latticeDensity(m.water, m.water.spacing), 1.02f * m.water.restDensity);
+  const float rest = restLatticeSpacing(m.water);
+  EXPECT_NEAR(latticeDensity(m.water, rest), m.water.restDensity, 1e-3f * m.water.restDensity);
+  EXPECT_GT(rest, m.water.spacing);
+  EXPECT_LT(rest, 1.03f * m.water.spacing);
 }
 
 TEST(EmitterBlock, EmittedInTheStepHoldingItsStart) {
