@@ -218,8 +218,13 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
       const auto& f = model.triangles[tri];
       const Vec3& n0 = s.startNormal[tri];
       const float dist = (xq0 - p.x[f[0]]).dot(n0);
+      const float own = dist >= 0.0f ? 1.0f : -1.0f;
+      if (own == sheetSide) {  // most candidates: both rules agree, no need to know where q projects
+        s.candidateSide[c] = own;
+        continue;
+      }
       const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
-      s.candidateSide[c] = over.minCoeff() >= -kFaceTolerance ? (dist >= 0.0f ? 1.0f : -1.0f) : sheetSide;
+      s.candidateSide[c] = over.minCoeff() >= -kFaceTolerance ? own : sheetSide;
     }
   });
 }
