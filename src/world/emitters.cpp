@@ -33,16 +33,21 @@ size_t emitBlock(const Model& model, State& state, const Emitter& e) {
   const int nx = latticeCount(e.boxMin.x(), e.boxMax.x(), s);
   const int ny = latticeCount(e.boxMin.y(), e.boxMax.y(), s);
   const int nz = latticeCount(e.boxMin.z(), e.boxMax.z(), s);
-  // as many sites as fit at the spacing, laid out at the rest spacing about the box's centre, so the
-  // block starts at rest density instead of 3.5% compressed (a departure, docs/models.md)
+  if (nx == 0 || ny == 0 || nz == 0) return 0;
+  // as many sites as fit at the spacing, spread towards the spacing of rest density as far as the box
+  // allows, centred: a block given room starts at rest instead of 3.5% compressed at Table 1's spacing,
+  // and a block that fills a container exactly stays inside it (a departure, docs/models.md)
+  const Vec3 extent = e.boxMax - e.boxMin;
   const float rest = restLatticeSpacing(model.water);
+  const float spread = std::min({rest, extent.x() / static_cast<float>(nx), extent.y() / static_cast<float>(ny),
+                                 extent.z() / static_cast<float>(nz)});
   const Vec3 first = 0.5f * (e.boxMin + e.boxMax) -
-                     0.5f * rest * Vec3(static_cast<float>(nx - 1), static_cast<float>(ny - 1), static_cast<float>(nz - 1));
+                     0.5f * spread * Vec3(static_cast<float>(nx - 1), static_cast<float>(ny - 1), static_cast<float>(nz - 1));
   size_t created = 0;
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
-        const Vec3 x = first + rest * Vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k));
+        const Vec3 x = first + spread * Vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k));
         if (!addWater(model, state, x, e.velocity)) return created;
         ++created;
       }

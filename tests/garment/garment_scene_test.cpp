@@ -145,6 +145,8 @@ TEST(GarmentSceneErrors, KeysOfTheOtherSolverAreRefused) {
              "\"implicit\"");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.material.selfCollision=true"}),
              "at cloth[0].material.selfCollision: expected false");
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.material.tetherSlack=0.1"}),
+             "at cloth[0].material.tetherSlack: expected no tetherSlack on a piece with \"solver\": \"implicit\"");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.solver=pbd"}), "at cloth[0].garment: expected no garment section on a piece "
                                                          "solved by PBD");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.solver=verlet"}), "at cloth[0].solver: expected one of \"pbd\", \"implicit\"");

@@ -149,7 +149,7 @@ TEST(Step, BlockOfWaterInFreeFallKeepsItsSize) {
   // the inequality density constraint it is a repulsion that nothing balances)
   Scene scene = sceneFromJson(R"({
     "solver": {"dt": 0.015, "substeps": 1, "gravity": [0, 0, 0], "domain": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
-    "emitters": [{"type": "block", "min": [-0.12, -0.12, -0.12], "max": [0.12, 0.12, 0.12]}]
+    "emitters": [{"type": "block", "min": [-0.1215, -0.1215, -0.1215], "max": [0.1215, 0.1215, 0.1215]}]
   })");
   const auto extent = [&] {
     const Particles& p = scene.state.particles;

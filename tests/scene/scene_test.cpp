@@ -269,6 +269,7 @@ TEST(SceneErrors, WrongTypeAndOutOfRange) {
   EXPECT_HAS(errorWith("cloth.0.mesh.resolution=[1, 3]"), "at cloth[0].mesh.resolution[0]: expected an integer >= 2, got 1");
   EXPECT_HAS(errorWith("solver.fluidIterations=0"), "at solver.fluidIterations: expected an integer >= 1, got 0");
   EXPECT_HAS(errorWith("solver.clothIterations=-1"), "at solver.clothIterations: expected an integer >= 0, got -1");
+  EXPECT_HAS(errorWith("cloth.0.material.tetherSlack=-0.1"), "at cloth[0].material.tetherSlack: expected a number >= 0");
   EXPECT_HAS(errorWith("output.water=1"), "at output.water: expected true or false, got 1");
   EXPECT_HAS(errorWith("cloth=3"), "test.json: at cloth: expected an array, got 3");
   EXPECT_HAS(errorWith("cloth.0.mesh.axisV=[0, 0, 0]"), "at cloth[0].mesh.axisV: expected a non-zero direction");

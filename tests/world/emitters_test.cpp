@@ -18,7 +18,7 @@ Model blockModel() {
   Emitter e;
   e.kind = EmitterKind::Block;
   e.boxMin = Vec3(0.3f, 1.0f, -0.05f);
-  e.boxMax = Vec3(0.4f, 1.1f, 0.05f);
+  e.boxMax = Vec3(0.402f, 1.102f, 0.052f);  // 5 sites a side, with room for the rest spacing
   e.velocity = Vec3(0, -1, 0.5f);
   e.start = 0.0f;
   m.emitters.push_back(e);
@@ -93,6 +93,21 @@ TEST(EmitterBlock, LaidOutAtTheSpacingOfRestDensity) {
   EXPECT_NEAR(latticeDensity(m.water, rest), m.water.restDensity, 1e-3f * m.water.restDensity);
   EXPECT_GT(rest, m.water.spacing);
   EXPECT_LT(rest, 1.03f * m.water.spacing);
+}
+
+TEST(EmitterBlock, ABoxWithoutRoomKeepsTheSpacingAndItsParticlesInside) {
+  Model m = blockModel();
+  m.emitters[0].boxMax = Vec3(0.4f, 1.1f, 0.05f);  // exactly 5 spacings a side, as a pool filling its container
+  State s;
+  ASSERT_EQ(emitWater(m, s, 0.0, 0.01f), 125u);
+  for (size_t i = 0; i < s.particles.size(); ++i) {
+    const Vec3 rel = (s.particles.x[i] - m.emitters[0].boxMin) / m.water.spacing - Vec3::Constant(0.5f);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(rel[a], std::round(rel[a]), 1e-3f);
+      EXPECT_GE(s.particles.x[i][a], m.emitters[0].boxMin[a] + 0.5f * m.water.spacing - 1e-5f);
+      EXPECT_LE(s.particles.x[i][a], m.emitters[0].boxMax[a] - 0.5f * m.water.spacing + 1e-5f);
+    }
+  }
 }
 
 TEST(EmitterBlock, EmittedInTheStepHoldingItsStart) {
