@@ -29,32 +29,29 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
   const float kappaS = rateForStep(w.smoothing, h / static_cast<float>(iterations), w.rateStep);
   const float kd = w.diffusionRate;  // isotropic cloth: (kappa_i^d + kappa_j^d) / 2 = kappa^d
   const float eta = w.diffusionGravity ? w.diffusionGravityFactor : 0.0f;
-  const Vec3 g = gravityDirection(model);
   const double c = w.c;
   std::vector<float>& sat = state.clothSaturation;
   s.sigma.resize(static_cast<size_t>(nc));
   s.delta.resize(static_cast<size_t>(nc));
 
-  // the pair's geometry, the same numbers seen from i or j (up to the sign of cos): the distance and
-  // w_ij / (1 + eta cos) = (kappa_i^d + kappa_j^d)/2 lap W_ij / rho0 (Eq. 12), and cos theta_ij
-  const auto pair = [&](int64_t i, int64_t j, float& cosIJ) {
-    const Vec3 d = p.x[i] - p.x[j];
-    const float r = d.norm();
-    cosIJ = r > 1e-12f ? d.dot(g) / r : 0.0f;
-    const float rho0 = model.pieces[clothPiece(p.phase[i])].material.restDensity;
-    return kd * viscosityLaplacian(r, pairRadius(p.radius[i], p.radius[j])) / rho0;
-  };
-  const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
-  const uint32_t cloth = static_cast<uint32_t>(nc);
   // nothing held, nothing to spread (the common case before the water arrives)
   bool any = false;
   for (int64_t i = 0; i < nc && !any; ++i) any = state.clothWater[i] > 0.0;
   if (!any) return;
 
+  // the pair's geometry (pairGeometry), the same numbers seen from i or j (up to the sign of cos):
+  // w_ij / (1 + eta cos) = (kappa_i^d + kappa_j^d)/2 lap W_ij / rho0 (Eq. 12), and cos theta_ij
+  ensurePairGeometry(model, p, nb, s);
+  const float* lap = s.pairLap.data();
+  const float* cosG = s.pairCos.data();
+  const auto restDensity = [&](int64_t i) { return model.pieces[clothPiece(p.phase[i])].material.restDensity; };
+  const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+
   for (int it = 0; it < iterations; ++it) {
     computeSaturation(model, state, s, sat);
     // sigma_i: the PBD step of i's constraint (Eq. 15-17) with the gradients of Eq. 16
-    parallelFor(nc, [&](int64_t i) {
+    parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
       float a = 0.0f, sq = 0.0f;
       // sigma_i is read only by exchanges with a neighbour of another saturation: skip it otherwise
       bool exchanges = false;
@@ -64,26 +61,27 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
         s.sigma[i] = 0.0f;
         return;
       }
+      const float rho0 = restDensity(i);
       for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
         const int64_t j = nb.index[e];
         if (!samePiece(i, j)) continue;
-        float cosIJ;
-        const float wij = pair(i, j, cosIJ) * (1.0f + eta * std::fabs(cosIJ));
+        const float wij = (kd * lap[e] / rho0) * (1.0f + eta * std::fabs(cosG[e]));
         a += wij;
         sq += wij * wij;
       }
       s.sigma[i] = a > 0.0f ? a / (a * a + sq + w.epsilon) : 0.0f;
     });
     // pairwise exchange, gathered per particle: the flow j -> i is bit for bit minus the flow i -> j
-    parallelFor(nc, [&](int64_t i) {
+    parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
       double dm = 0.0;
+      const float rho0 = restDensity(i);
       for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
         const int64_t j = nb.index[e];
         if (!samePiece(i, j)) continue;
         const double diff = static_cast<double>(sat[j]) - static_cast<double>(sat[i]);
         if (diff == 0.0) continue;
-        float cosIJ;
-        const float base = pair(i, j, cosIJ);
+        const float cosIJ = cosG[e];
+        const float base = kd * lap[e] / rho0;
         // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
         const float cosFlow = diff > 0.0 ? cosIJ : -cosIJ;
         const double coef = static_cast<double>(kappaS) * std::min(s.sigma[i], s.sigma[j]) *

@@ -87,57 +87,65 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
   const uint32_t cloth = static_cast<uint32_t>(nc);  // loops below read the cloth part of the lists
 
+  // the pairs' cos theta, poly6 and spiky gradient factor (pairGeometry): cos theta_ji is exactly
+  // -cos theta_ij and the kernels are symmetric, so the numbers are the same seen from either side
+  ensurePairGeometry(model, p, nb, s);
+  const float* cosG = s.pairCos.data();
+  const float* poly = s.pairPoly6.data();
+  const float* spikyF = s.pairSpiky.data();
+
   // 2. Eq. 18: does gravity beat the pull of the wet neighbours above?
   s.transfers.assign(static_cast<size_t>(nc), 0);
-  parallelFor(nc, [&](int64_t i) {
+  parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     if (state.clothBuffer[i] <= 0.0) return;
     Vec3 pull = Vec3::Zero();
     for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {
       const int64_t j = nb.index[e];
       if (!samePiece(i, j)) continue;
-      const float cosIJ = cosGravity(p.x[i], p.x[j], g);
+      const float cosIJ = cosG[e];  // cosGravity(x_i, x_j, g)
       if (cosIJ <= 0.0f) continue;  // j is not above i
-      pull += (s.volume[j] * sat[j] * cosIJ) * spikyGrad(p.x[i] - p.x[j], pairRadius(p.radius[i], p.radius[j]));
+      // spikyGrad(x_i - x_j, h_ij) = f (x_i - x_j)
+      pull += (s.volume[j] * sat[j] * cosIJ) * Vec3(spikyF[e] * Vec3(p.x[i] - p.x[j]));
     }
     s.transfers[i] = pull.norm() < w.beta * gMag;
   });
   // 3. the buffer of an upper particle u flowing to a lower neighbour l, before and after scaling;
   // cosLU = cos theta_lu > 0 (l below u) and r2 = |x_l - x_u|^2 are the same numbers seen from u or l
   const double rate = std::min(1.0, static_cast<double>(h) / w.rateStep);
-  const auto rawFlow = [&](int64_t u, int64_t l, float cosLU, float r2) -> double {
-    const float vw = s.volume[u] * poly6(r2, pairRadius(p.radius[u], p.radius[l]));
+  // (poly6(r2, h_lu) is the pair's poly6, the same from u's or l's list)
+  const auto rawFlow = [&](int64_t u, float cosLU, float poly6LU) -> double {
+    const float vw = s.volume[u] * poly6LU;
     return rate * static_cast<double>(cosLU * vw) * state.clothBuffer[u];
   };
   int anyTransfer = 0;
   for (int64_t i = 0; i < nc && !anyTransfer; ++i) anyTransfer = s.transfers[i];
   if (anyTransfer) {
     s.outScale.assign(static_cast<size_t>(nc), 0.0f);
-    parallelFor(nc, [&](int64_t u) {
+    parallelForDynamic(nc, kWetChunk, [&](int64_t u) {
       if (!s.transfers[u]) return;
       double out = 0.0;
       for (uint32_t e = nb.start[u], end = nb.clothEnd(u, cloth); e < end; ++e) {
         const int64_t l = nb.index[e];
         if (!samePiece(u, l)) continue;
-        const float cosLU = cosGravity(p.x[l], p.x[u], g);
-        if (cosLU > 0.0f) out += rawFlow(u, l, cosLU, (p.x[l] - p.x[u]).squaredNorm());
+        const float cosLU = -cosG[e];  // cosGravity(x_l, x_u, g)
+        if (cosLU > 0.0f) out += rawFlow(u, cosLU, poly[e]);
       }
       // the fractions sum below one; this only guards strongly compressed cloth
       s.outScale[u] = out > state.clothBuffer[u] ? static_cast<float>(state.clothBuffer[u] / out) : 1.0f;
     });
     // gathered per particle: what arrives from above minus what leaves below, the same numbers both ways
     s.delta.resize(static_cast<size_t>(nc));
-    parallelFor(nc, [&](int64_t k) {
+    parallelForDynamic(nc, kWetChunk, [&](int64_t k) {
       double d = 0.0;
       for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end; ++e) {
         const int64_t j = nb.index[e];
         if (!samePiece(k, j)) continue;
         if (!s.transfers[j] && !s.transfers[k]) continue;  // neither sheds water: no flow either way
-        const float cosKJ = cosGravity(p.x[k], p.x[j], g);  // > 0: k below j; cos theta_jk is exactly -cosKJ
-        const float r2 = (p.x[k] - p.x[j]).squaredNorm();
+        const float cosKJ = cosG[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
         if (cosKJ > 0.0f && s.transfers[j])
-          d += static_cast<double>(s.outScale[j]) * rawFlow(j, k, cosKJ, r2);
+          d += static_cast<double>(s.outScale[j]) * rawFlow(j, cosKJ, poly[e]);
         else if (cosKJ < 0.0f && s.transfers[k])
-          d -= static_cast<double>(s.outScale[k]) * rawFlow(k, j, -cosKJ, r2);
+          d -= static_cast<double>(s.outScale[k]) * rawFlow(k, -cosKJ, poly[e]);
       }
       s.delta[k] = d;
     });
