@@ -48,46 +48,83 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
   const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
   const uint32_t cloth = static_cast<uint32_t>(nc);
 
+  // Both neighbour loops below compute each pair's term in a vectorised loop (plain floats and
+  // doubles, selects, the arithmetic of the scalar expression) into a per-thread buffer and sum the
+  // terms in list order, so every result is that of the scalar loop. A pair that is skipped (another
+  // piece, equal saturations) contributes a zero, which leaves a sum started at +0 unchanged.
+  const uint32_t* const index = nb.index.data();
+  const int32_t* const phase = p.phase.data();
+  const float* const S = sat.data();
+  const float* const V = s.volume.data();
+  float* const sigma = s.sigma.data();
   for (int it = 0; it < iterations; ++it) {
     computeSaturation(model, state, s, sat);
     // sigma_i: the PBD step of i's constraint (Eq. 15-17) with the gradients of Eq. 16
     parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
-      float a = 0.0f, sq = 0.0f;
       // sigma_i is read only by exchanges with a neighbour of another saturation: skip it otherwise
       bool exchanges = false;
       for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end && !exchanges; ++e)
         exchanges = samePiece(i, nb.index[e]) && sat[nb.index[e]] != sat[i];
       if (!exchanges) {
-        s.sigma[i] = 0.0f;
+        sigma[i] = 0.0f;
         return;
       }
-      const float rho0 = restDensity(i);
-      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
-        const int64_t j = nb.index[e];
-        if (!samePiece(i, j)) continue;
-        const float wij = (kd * lap[e] / rho0) * (1.0f + eta * std::fabs(cosG[e]));
+      const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
+      const float* const L = lap + begin;
+      const float* const C = cosG + begin;
+      float* const W = threadBuffer<float>(count);
+      const float rho0 = restDensity(i), kdL = kd, etaL = eta;  // locals: GCC does not vectorise
+#pragma omp simd                                                  // loads through the closure
+      for (uint32_t k = 0; k < count; ++k) W[k] = (kdL * L[k] / rho0) * (1.0f + etaL * std::fabs(C[k]));
+      float a = 0.0f, sq = 0.0f;
+      for (uint32_t k = 0; k < count; ++k) {  // cloth neighbours only
+        if (!samePiece(i, index[begin + k])) continue;
+        const float wij = W[k];
         a += wij;
         sq += wij * wij;
       }
-      s.sigma[i] = a > 0.0f ? a / (a * a + sq + w.epsilon) : 0.0f;
+      sigma[i] = a > 0.0f ? a / (a * a + sq + w.epsilon) : 0.0f;
     });
     // pairwise exchange, gathered per particle: the flow j -> i is bit for bit minus the flow i -> j
     parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
-      double dm = 0.0;
-      const float rho0 = restDensity(i);
-      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
-        const int64_t j = nb.index[e];
-        if (!samePiece(i, j)) continue;
-        const double diff = static_cast<double>(sat[j]) - static_cast<double>(sat[i]);
-        if (diff == 0.0) continue;
-        const float cosIJ = cosG[e];
-        const float base = kd * lap[e] / rho0;
-        // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
-        const float cosFlow = diff > 0.0 ? cosIJ : -cosIJ;
-        const double coef = static_cast<double>(kappaS) * std::min(s.sigma[i], s.sigma[j]) *
-                            (base * (1.0f + eta * cosFlow)) * std::min(s.volume[i], s.volume[j]) / c;
-        dm += coef * diff;
+      // sigma_i = 0 makes every coefficient min(sigma_i, sigma_j) ... zero: nothing moves
+      if (sigma[i] == 0.0f) {
+        s.delta[i] = 0.0;
+        return;
       }
+      const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
+      const uint32_t* const J = index + begin;
+      const float* const L = lap + begin;
+      const float* const C = cosG + begin;
+      double* const T = threadBuffer<double>(count);
+      // locals: GCC does not vectorise loads through the closure
+      const int32_t* const P = phase;
+      const float* const SL = S;
+      const float* const SG = sigma;
+      const float* const VL = V;
+      const float rho0 = restDensity(i), kdL = kd, etaL = eta, kappaL = kappaS;
+      const double cL = c;
+      const uint32_t clothL = cloth;
+      const int32_t phi = P[i];
+      const float si = SL[i], sgi = SG[i], vi = VL[i];
+#pragma omp simd
+      for (uint32_t k = 0; k < count; ++k) {  // cloth neighbours only
+        const uint32_t j = J[k];
+        const bool same = (j < clothL) & (P[j] == phi);
+        const uint32_t jj = same ? j : static_cast<uint32_t>(i);  // S, sigma and V hold cloth only
+        const double diff = static_cast<double>(SL[jj]) - static_cast<double>(si);
+        const float base = kdL * L[k] / rho0;
+        // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
+        const float cosFlow = diff > 0.0 ? C[k] : -C[k];
+        const float sgj = SG[jj], vj = VL[jj];
+        const float minSigma = sgj < sgi ? sgj : sgi;  // std::min(sigma_i, sigma_j)
+        const float minV = vj < vi ? vj : vi;          // std::min(V_i, V_j)
+        const double coef =
+            static_cast<double>(kappaL) * minSigma * (base * (1.0f + etaL * cosFlow)) * minV / cL;
+        T[k] = coef * diff;  // +-0 for a pair of another piece (jj = i, diff = 0)
+      }
+      double dm = 0.0;
+      for (uint32_t k = 0; k < count; ++k) dm += T[k];
       s.delta[i] = dm;
     });
     parallelFor(nc, [&](int64_t i) { state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]); });

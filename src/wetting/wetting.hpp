@@ -24,6 +24,16 @@ namespace soak {
 // part of a cloth costs far more per particle than the dry part, and is rarely split evenly
 constexpr int64_t kWetChunk = 256;
 
+// a per-thread buffer of at least n values, for the per-pair terms of one particle's neighbour loop:
+// a vectorised loop writes them, a scalar loop then sums them in list order (the order of the sums
+// stays that of the scalar code, and with it every result)
+template <class T>
+inline T* threadBuffer(size_t n) {
+  thread_local std::vector<T> buffer;
+  if (buffer.size() < n) buffer.resize(n);
+  return buffer.data();
+}
+
 // scratch of the wetting stages, reused from substep to substep
 struct WettingScratch {
   std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this substep
