@@ -184,6 +184,14 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     // flows would be zeros anyway)
     s.delta.resize(static_cast<size_t>(nc));
     parallelForDynamic(nc, kWetChunk, [&](int64_t k) {
+      // no flow either way unless k or a neighbour sheds (most of a cloth): d stays +0
+      bool sheds = s.transfers[k];
+      for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end && !sheds; ++e)
+        sheds = nb.index[e] < cloth && s.transfers[nb.index[e]];
+      if (!sheds) {
+        s.delta[k] = 0.0;
+        return;
+      }
       const uint32_t begin = nb.start[k], count = nb.clothEnd(k, cloth) - begin;
       const uint32_t* const J = indexAll + begin;
       const float* const C = cosG + begin;
