@@ -57,8 +57,8 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
   const float* const S = sat.data();
   const float* const V = s.volume.data();
   float* const sigma = s.sigma.data();
+  computeSaturation(model, state, s, sat);  // absorption changed the held water
   for (int it = 0; it < iterations; ++it) {
-    computeSaturation(model, state, s, sat);
     // sigma_i: the PBD step of i's constraint (Eq. 15-17) with the gradients of Eq. 16
     parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
       // sigma_i is read only by exchanges with a neighbour of another saturation: skip it otherwise
@@ -127,9 +127,12 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
       for (uint32_t k = 0; k < count; ++k) dm += T[k];
       s.delta[i] = dm;
     });
-    parallelFor(nc, [&](int64_t i) { state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]); });
+    // the exchange, and S_i for the next iteration or stage (computeSaturation, in the same loop)
+    parallelFor(nc, [&](int64_t i) {
+      state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]);
+      sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+    });
   }
-  computeSaturation(model, state, s, sat);
 }
 
 }  // namespace soak

@@ -73,7 +73,10 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const float gMag = model.solver.gravity.norm();
   const double c = w.c;
 
-  // 1. water above S^EW goes into the buffer: EW_i = max(0, (S_i - S^EW) V_i) / c
+  // 1. water above S^EW goes into the buffer: EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as
+  // computeSaturation, in the same loop
+  std::vector<float>& sat = state.clothSaturation;
+  sat.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
     const double keep = static_cast<double>(w.saturationEmit) * s.volume[i] / c;
     const double excess = state.clothWater[i] - keep;
@@ -81,9 +84,8 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       state.clothWater[i] = keep;
       state.clothBuffer[i] += excess;
     }
+    sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
   });
-  std::vector<float>& sat = state.clothSaturation;
-  computeSaturation(model, state, s, sat);
   const uint32_t cloth = static_cast<uint32_t>(nc);  // loops below read the cloth part of the lists
 
   // the pairs' cos theta, poly6 and spiky gradient factor (pairGeometry): cos theta_ji is exactly

@@ -90,7 +90,12 @@ void computeSaturation(const Model& model, const State& state, const WettingScra
 // (Eigen's squaredNorm and dot of a Vec3 are x + (y + z)): poly6(), viscosityLaplacian(), spikyGrad()
 // and cosGravity() at (x_i - x_j, pairRadius(h_i, h_j)) give bit for bit the stored values. Only
 // values are stored, no sums, so the vector width changes nothing.
-void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s) {
+namespace {
+
+// pairGeometry, then after(i) for each cloth particle i in the same parallel loop (one fork and join)
+template <class After>
+void pairGeometryThen(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s,
+                      After&& after) {
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
   const size_t entries = nb.index.size();
@@ -143,10 +148,17 @@ void pairGeometry(const Model& model, const Particles& p, const NeighborLists& n
       const float rGrad = inGrad ? r : 1.0f;
       F[e] = inGrad ? -45.0f / (kPi * h3 * h3) * dh * dh / rGrad : 0.0f;
     }
+    after(i);
   });
   s.pairsList = nb.index.data();
   s.pairsSize = entries;
   s.pairsValid = true;
+}
+
+}  // namespace
+
+void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s) {
+  pairGeometryThen(model, p, nb, s, [](int64_t) {});
 }
 
 void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s) {
@@ -157,12 +169,14 @@ void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLi
 void updatePorosity(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s) {
   if (!model.wetting.enabled || model.numCloth == 0) return;
   const Particles& p = state.particles;
-  pairGeometry(model, p, nb, s);
-  // V_i = 1 / sum_k W_ik (Eq. 10), as clothVolumes: the same terms in the same order
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
+  const double c = model.wetting.c;
   s.volume.resize(static_cast<size_t>(nc));
-  parallelFor(nc, [&](int64_t i) {
+  state.clothSaturation.resize(static_cast<size_t>(nc));
+  // in the loop of the pair geometry, once i's pairs are done: V_i = 1 / sum_k W_ik (Eq. 10) as
+  // clothVolumes (the same terms in the same order), S_i as computeSaturation, and the wet mass
+  pairGeometryThen(model, p, nb, s, [&](int64_t i) {
     float sum = poly6(0.0f, p.radius[i]);  // k includes i itself
     for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {
       const uint32_t j = nb.index[e];
@@ -170,9 +184,9 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
       sum += s.pairPoly6[e];
     }
     s.volume[i] = 1.0f / sum;
+    state.clothSaturation[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+    setWetMass(model, state, i);
   });
-  computeSaturation(model, state, s, state.clothSaturation);
-  parallelFor(model.numCloth, [&](int64_t i) { setWetMass(model, state, i); });
 }
 
 }  // namespace soak
