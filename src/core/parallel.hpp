@@ -16,6 +16,15 @@ inline void parallelFor(int64_t n, F&& body) {
   for (int64_t i = 0; i < n; ++i) body(i);
 }
 
+// the same for loops whose items cost very different amounts (wet and dry cloth): chunks of `chunk`
+// items go to whichever thread is free. Each item still writes only its own results, so the
+// schedule changes no result.
+template <class F>
+inline void parallelForDynamic(int64_t n, int64_t chunk, F&& body) {
+#pragma omp parallel for schedule(dynamic, chunk) if (n >= kParallelGrain)
+  for (int64_t i = 0; i < n; ++i) body(i);
+}
+
 inline int threadCount() { return omp_get_max_threads(); }
 inline void setThreadCount(int n) {
   if (n > 0) omp_set_num_threads(n);

@@ -71,7 +71,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
   parallelFor(nc, [&](int64_t i) {
     if (s.capacity[i] <= 0.0f) return;
     float offered = 0.0f;
-    for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+    for (uint32_t e = nb.waterBegin(i, static_cast<uint32_t>(nc)); e < nb.start[i + 1]; ++e) {  // water part
       const int64_t j = nb.index[e];
       if (j >= nc && s.waterScale[j] > 0.0f) offered += s.waterScale[j] * request(i, j);
     }
@@ -145,6 +145,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
 }
 
 void finishWetting(const Model& model, State& state, WettingScratch& s) {
+  s.pairsValid = false;  // the next substep moves the cloth and rebuilds the lists
   if (!model.wetting.enabled) return;
   if (s.anyAbsorbedWhole) {
     // drips made after the absorption stage sit past the end of keep: they stay

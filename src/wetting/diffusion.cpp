@@ -29,72 +29,110 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
   const float kappaS = rateForStep(w.smoothing, h / static_cast<float>(iterations), w.rateStep);
   const float kd = w.diffusionRate;  // isotropic cloth: (kappa_i^d + kappa_j^d) / 2 = kappa^d
   const float eta = w.diffusionGravity ? w.diffusionGravityFactor : 0.0f;
-  const Vec3 g = gravityDirection(model);
   const double c = w.c;
   std::vector<float>& sat = state.clothSaturation;
   s.sigma.resize(static_cast<size_t>(nc));
   s.delta.resize(static_cast<size_t>(nc));
 
-  // the pair's geometry, the same numbers seen from i or j (up to the sign of cos): the distance and
-  // w_ij / (1 + eta cos) = (kappa_i^d + kappa_j^d)/2 lap W_ij / rho0 (Eq. 12), and cos theta_ij
-  const auto pair = [&](int64_t i, int64_t j, float& cosIJ) {
-    const Vec3 d = p.x[i] - p.x[j];
-    const float r = d.norm();
-    cosIJ = r > 1e-12f ? d.dot(g) / r : 0.0f;
-    const float rho0 = model.pieces[clothPiece(p.phase[i])].material.restDensity;
-    return kd * viscosityLaplacian(r, pairRadius(p.radius[i], p.radius[j])) / rho0;
-  };
-  const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
-  const uint32_t cloth = static_cast<uint32_t>(nc);
   // nothing held, nothing to spread (the common case before the water arrives)
   bool any = false;
   for (int64_t i = 0; i < nc && !any; ++i) any = state.clothWater[i] > 0.0;
   if (!any) return;
 
+  // the pair's geometry (pairGeometry), the same numbers seen from i or j (up to the sign of cos):
+  // w_ij / (1 + eta cos) = (kappa_i^d + kappa_j^d)/2 lap W_ij / rho0 (Eq. 12), and cos theta_ij
+  ensurePairGeometry(model, p, nb, s);
+  const float* lap = s.pairLap.data();
+  const float* cosG = s.pairCos.data();
+  const auto restDensity = [&](int64_t i) { return model.pieces[clothPiece(p.phase[i])].material.restDensity; };
+  const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+
+  // Both neighbour loops below compute each pair's term in a vectorised loop (plain floats and
+  // doubles, selects, the arithmetic of the scalar expression) into a per-thread buffer and sum the
+  // terms in list order, so every result is that of the scalar loop. A pair that is skipped (another
+  // piece, equal saturations) contributes a zero, which leaves a sum started at +0 unchanged.
+  const uint32_t* const index = nb.index.data();
+  const int32_t* const phase = p.phase.data();
+  const float* const S = sat.data();
+  const float* const V = s.volume.data();
+  float* const sigma = s.sigma.data();
+  computeSaturation(model, state, s, sat);  // absorption changed the held water
   for (int it = 0; it < iterations; ++it) {
-    computeSaturation(model, state, s, sat);
     // sigma_i: the PBD step of i's constraint (Eq. 15-17) with the gradients of Eq. 16
-    parallelFor(nc, [&](int64_t i) {
-      float a = 0.0f, sq = 0.0f;
+    parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
       // sigma_i is read only by exchanges with a neighbour of another saturation: skip it otherwise
       bool exchanges = false;
       for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end && !exchanges; ++e)
         exchanges = samePiece(i, nb.index[e]) && sat[nb.index[e]] != sat[i];
       if (!exchanges) {
-        s.sigma[i] = 0.0f;
+        sigma[i] = 0.0f;
         return;
       }
-      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
-        const int64_t j = nb.index[e];
-        if (!samePiece(i, j)) continue;
-        float cosIJ;
-        const float wij = pair(i, j, cosIJ) * (1.0f + eta * std::fabs(cosIJ));
+      const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
+      const float* const L = lap + begin;
+      const float* const C = cosG + begin;
+      float* const W = threadBuffer<float>(count);
+      const float rho0 = restDensity(i), kdL = kd, etaL = eta;  // locals: GCC does not vectorise
+#pragma omp simd                                                  // loads through the closure
+      for (uint32_t k = 0; k < count; ++k) W[k] = (kdL * L[k] / rho0) * (1.0f + etaL * std::fabs(C[k]));
+      float a = 0.0f, sq = 0.0f;
+      for (uint32_t k = 0; k < count; ++k) {  // cloth neighbours only
+        if (!samePiece(i, index[begin + k])) continue;
+        const float wij = W[k];
         a += wij;
         sq += wij * wij;
       }
-      s.sigma[i] = a > 0.0f ? a / (a * a + sq + w.epsilon) : 0.0f;
+      sigma[i] = a > 0.0f ? a / (a * a + sq + w.epsilon) : 0.0f;
     });
     // pairwise exchange, gathered per particle: the flow j -> i is bit for bit minus the flow i -> j
-    parallelFor(nc, [&](int64_t i) {
-      double dm = 0.0;
-      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {  // cloth neighbours only
-        const int64_t j = nb.index[e];
-        if (!samePiece(i, j)) continue;
-        const double diff = static_cast<double>(sat[j]) - static_cast<double>(sat[i]);
-        if (diff == 0.0) continue;
-        float cosIJ;
-        const float base = pair(i, j, cosIJ);
-        // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
-        const float cosFlow = diff > 0.0 ? cosIJ : -cosIJ;
-        const double coef = static_cast<double>(kappaS) * std::min(s.sigma[i], s.sigma[j]) *
-                            (base * (1.0f + eta * cosFlow)) * std::min(s.volume[i], s.volume[j]) / c;
-        dm += coef * diff;
+    parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
+      // sigma_i = 0 makes every coefficient min(sigma_i, sigma_j) ... zero: nothing moves
+      if (sigma[i] == 0.0f) {
+        s.delta[i] = 0.0;
+        return;
       }
+      const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
+      const uint32_t* const J = index + begin;
+      const float* const L = lap + begin;
+      const float* const C = cosG + begin;
+      double* const T = threadBuffer<double>(count);
+      // locals: GCC does not vectorise loads through the closure
+      const int32_t* const P = phase;
+      const float* const SL = S;
+      const float* const SG = sigma;
+      const float* const VL = V;
+      const float rho0 = restDensity(i), kdL = kd, etaL = eta, kappaL = kappaS;
+      const double cL = c;
+      const uint32_t clothL = cloth;
+      const int32_t phi = P[i];
+      const float si = SL[i], sgi = SG[i], vi = VL[i];
+#pragma omp simd
+      for (uint32_t k = 0; k < count; ++k) {  // cloth neighbours only
+        const uint32_t j = J[k];
+        const bool same = (j < clothL) & (P[j] == phi);
+        const uint32_t jj = same ? j : static_cast<uint32_t>(i);  // S, sigma and V hold cloth only
+        const double diff = static_cast<double>(SL[jj]) - static_cast<double>(si);
+        const float base = kdL * L[k] / rho0;
+        // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
+        const float cosFlow = diff > 0.0 ? C[k] : -C[k];
+        const float sgj = SG[jj], vj = VL[jj];
+        const float minSigma = sgj < sgi ? sgj : sgi;  // std::min(sigma_i, sigma_j)
+        const float minV = vj < vi ? vj : vi;          // std::min(V_i, V_j)
+        const double coef =
+            static_cast<double>(kappaL) * minSigma * (base * (1.0f + etaL * cosFlow)) * minV / cL;
+        T[k] = coef * diff;  // +-0 for a pair of another piece (jj = i, diff = 0)
+      }
+      double dm = 0.0;
+      for (uint32_t k = 0; k < count; ++k) dm += T[k];
       s.delta[i] = dm;
     });
-    parallelFor(nc, [&](int64_t i) { state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]); });
+    // the exchange, and S_i for the next iteration or stage (computeSaturation, in the same loop)
+    parallelFor(nc, [&](int64_t i) {
+      state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]);
+      sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+    });
   }
-  computeSaturation(model, state, s, sat);
 }
 
 }  // namespace soak

@@ -73,7 +73,10 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const float gMag = model.solver.gravity.norm();
   const double c = w.c;
 
-  // 1. water above S^EW goes into the buffer: EW_i = max(0, (S_i - S^EW) V_i) / c
+  // 1. water above S^EW goes into the buffer: EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as
+  // computeSaturation, in the same loop
+  std::vector<float>& sat = state.clothSaturation;
+  sat.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
     const double keep = static_cast<double>(w.saturationEmit) * s.volume[i] / c;
     const double excess = state.clothWater[i] - keep;
@@ -81,64 +84,145 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       state.clothWater[i] = keep;
       state.clothBuffer[i] += excess;
     }
+    sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
   });
-  std::vector<float>& sat = state.clothSaturation;
-  computeSaturation(model, state, s, sat);
-  const auto samePiece = [&](int64_t i, int64_t j) { return j < nc && p.phase[j] == p.phase[i]; };
   const uint32_t cloth = static_cast<uint32_t>(nc);  // loops below read the cloth part of the lists
+
+  // the pairs' cos theta, poly6 and spiky gradient factor (pairGeometry): cos theta_ji is exactly
+  // -cos theta_ij and the kernels are symmetric, so the numbers are the same seen from either side
+  ensurePairGeometry(model, p, nb, s);
+  const float* cosG = s.pairCos.data();
+  const float* poly = s.pairPoly6.data();
+  const float* spikyF = s.pairSpiky.data();
+
+  // Each neighbour loop below computes the pairs' terms in a vectorised loop (plain floats and
+  // doubles, selects, the arithmetic of the scalar expressions) into a per-thread buffer and sums them
+  // in list order, so every result is that of the scalar loop. A pair the scalar loop skipped
+  // contributes a zero, which leaves a sum started at +0 unchanged. Pointers are copied into the
+  // loops' own locals: GCC does not vectorise loads through a lambda's captures.
+  const uint32_t* const indexAll = nb.index.data();
+  const int32_t* const phaseAll = p.phase.data();
+  const float* const xAll = p.x[0].data();
+  const float* const satAll = sat.data();
+  const float* const volumeAll = s.volume.data();
+  const double* const bufferAll = state.clothBuffer.data();
 
   // 2. Eq. 18: does gravity beat the pull of the wet neighbours above?
   s.transfers.assign(static_cast<size_t>(nc), 0);
-  parallelFor(nc, [&](int64_t i) {
-    if (state.clothBuffer[i] <= 0.0) return;
-    Vec3 pull = Vec3::Zero();
-    for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {
-      const int64_t j = nb.index[e];
-      if (!samePiece(i, j)) continue;
-      const float cosIJ = cosGravity(p.x[i], p.x[j], g);
-      if (cosIJ <= 0.0f) continue;  // j is not above i
-      pull += (s.volume[j] * sat[j] * cosIJ) * spikyGrad(p.x[i] - p.x[j], pairRadius(p.radius[i], p.radius[j]));
+  const float pullLimit = w.beta * gMag;
+  parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
+    if (bufferAll[i] <= 0.0) return;
+    const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
+    const uint32_t* const J = indexAll + begin;
+    const float* const C = cosG + begin;
+    const float* const F = spikyF + begin;
+    const int32_t* const P = phaseAll;
+    const float* const X = xAll;
+    const float* const SL = satAll;
+    const float* const VL = volumeAll;
+    float* const Tx = threadBuffer<float>(3 * static_cast<size_t>(count));
+    float* const Ty = Tx + count;
+    float* const Tz = Ty + count;
+    const uint32_t clothL = cloth;
+    const int32_t phi = P[i];
+    const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+#pragma omp simd
+    for (uint32_t k = 0; k < count; ++k) {
+      const uint32_t j = J[k];
+      const bool same = (j < clothL) & (P[j] == phi);
+      const uint32_t jj = same ? j : static_cast<uint32_t>(i);  // S and V hold cloth only
+      const float cosIJ = C[k];                                 // cosGravity(x_i, x_j, g)
+      const bool above = same & (cosIJ > 0.0f);                 // j is above i
+      // (V_j S_j cos) spikyGrad(x_i - x_j, h_ij), spikyGrad = f (x_i - x_j)
+      const float q = VL[jj] * SL[jj] * cosIJ, f = F[k];
+      const float dx = xi - X[3 * j], dy = yi - X[3 * j + 1], dz = zi - X[3 * j + 2];
+      // times 1 or 0, not a select: GCC would make the gathers masked, which it cannot emulate
+      const float m = above ? 1.0f : 0.0f;
+      Tx[k] = q * (f * dx) * m;
+      Ty[k] = q * (f * dy) * m;
+      Tz[k] = q * (f * dz) * m;
     }
-    s.transfers[i] = pull.norm() < w.beta * gMag;
+    Vec3 pull = Vec3::Zero();
+    for (uint32_t k = 0; k < count; ++k) pull += Vec3(Tx[k], Ty[k], Tz[k]);
+    s.transfers[i] = pull.norm() < pullLimit;
   });
-  // 3. the buffer of an upper particle u flowing to a lower neighbour l, before and after scaling;
-  // cosLU = cos theta_lu > 0 (l below u) and r2 = |x_l - x_u|^2 are the same numbers seen from u or l
+  // 3. the buffer of an upper particle u flowing to a lower neighbour l, before and after scaling:
+  // rate cos theta_lu V_u W_lu EW_u; cos theta_lu > 0 (l below u) and W_lu = poly6(|x_l - x_u|^2, h_lu)
+  // are the pair's numbers (pairGeometry), the same seen from u or l
   const double rate = std::min(1.0, static_cast<double>(h) / w.rateStep);
-  const auto rawFlow = [&](int64_t u, int64_t l, float cosLU, float r2) -> double {
-    const float vw = s.volume[u] * poly6(r2, pairRadius(p.radius[u], p.radius[l]));
-    return rate * static_cast<double>(cosLU * vw) * state.clothBuffer[u];
-  };
   int anyTransfer = 0;
   for (int64_t i = 0; i < nc && !anyTransfer; ++i) anyTransfer = s.transfers[i];
   if (anyTransfer) {
-    s.outScale.assign(static_cast<size_t>(nc), 0.0f);
-    parallelFor(nc, [&](int64_t u) {
+    s.outScale.assign(static_cast<size_t>(nc), 0.0f);  // stays 0 exactly where transfers is 0
+    const float* const outScaleAll = s.outScale.data();
+    parallelForDynamic(nc, kWetChunk, [&](int64_t u) {
       if (!s.transfers[u]) return;
+      const uint32_t begin = nb.start[u], count = nb.clothEnd(u, cloth) - begin;
+      const uint32_t* const J = indexAll + begin;
+      const float* const C = cosG + begin;
+      const float* const W = poly + begin;
+      const int32_t* const P = phaseAll;
+      double* const T = threadBuffer<double>(count);
+      const uint32_t clothL = cloth;
+      const int32_t phu = P[u];
+      const float vu = volumeAll[u];
+      const double bu = bufferAll[u], rateL = rate;
+#pragma omp simd
+      for (uint32_t k = 0; k < count; ++k) {
+        const uint32_t l = J[k];
+        const bool same = (l < clothL) & (P[l] == phu);
+        const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
+        const bool below = same & (cosLU > 0.0f);
+        const float vw = vu * W[k];
+        T[k] = rateL * static_cast<double>(cosLU * vw * (below ? 1.0f : 0.0f)) * bu;  // +-0 where not below
+      }
       double out = 0.0;
-      for (uint32_t e = nb.start[u], end = nb.clothEnd(u, cloth); e < end; ++e) {
-        const int64_t l = nb.index[e];
-        if (!samePiece(u, l)) continue;
-        const float cosLU = cosGravity(p.x[l], p.x[u], g);
-        if (cosLU > 0.0f) out += rawFlow(u, l, cosLU, (p.x[l] - p.x[u]).squaredNorm());
-      }
+      for (uint32_t k = 0; k < count; ++k) out += T[k];
       // the fractions sum below one; this only guards strongly compressed cloth
-      s.outScale[u] = out > state.clothBuffer[u] ? static_cast<float>(state.clothBuffer[u] / out) : 1.0f;
+      s.outScale[u] = out > bu ? static_cast<float>(bu / out) : 1.0f;
     });
-    // gathered per particle: what arrives from above minus what leaves below, the same numbers both ways
+    // gathered per particle: what arrives from above minus what leaves below, the same numbers both
+    // ways. outScale > 0 stands for transfers (a shedding particle's scale is positive; were it 0 its
+    // flows would be zeros anyway)
     s.delta.resize(static_cast<size_t>(nc));
-    parallelFor(nc, [&](int64_t k) {
-      double d = 0.0;
-      for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end; ++e) {
-        const int64_t j = nb.index[e];
-        if (!samePiece(k, j)) continue;
-        if (!s.transfers[j] && !s.transfers[k]) continue;  // neither sheds water: no flow either way
-        const float cosKJ = cosGravity(p.x[k], p.x[j], g);  // > 0: k below j; cos theta_jk is exactly -cosKJ
-        const float r2 = (p.x[k] - p.x[j]).squaredNorm();
-        if (cosKJ > 0.0f && s.transfers[j])
-          d += static_cast<double>(s.outScale[j]) * rawFlow(j, k, cosKJ, r2);
-        else if (cosKJ < 0.0f && s.transfers[k])
-          d -= static_cast<double>(s.outScale[k]) * rawFlow(k, j, -cosKJ, r2);
+    parallelForDynamic(nc, kWetChunk, [&](int64_t k) {
+      // no flow either way unless k or a neighbour sheds (most of a cloth): d stays +0
+      bool sheds = s.transfers[k];
+      for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end && !sheds; ++e)
+        sheds = nb.index[e] < cloth && s.transfers[nb.index[e]];
+      if (!sheds) {
+        s.delta[k] = 0.0;
+        return;
       }
+      const uint32_t begin = nb.start[k], count = nb.clothEnd(k, cloth) - begin;
+      const uint32_t* const J = indexAll + begin;
+      const float* const C = cosG + begin;
+      const float* const W = poly + begin;
+      const int32_t* const P = phaseAll;
+      const float* const VL = volumeAll;
+      const float* const OS = outScaleAll;
+      const double* const B = bufferAll;
+      double* const T = threadBuffer<double>(count);
+      const uint32_t clothL = cloth;
+      const int32_t phk = P[k];
+      const float vk = VL[k], osk = OS[k];
+      const double bk = B[k], rateL = rate;
+#pragma omp simd
+      for (uint32_t e = 0; e < count; ++e) {
+        const uint32_t j = J[e];
+        const bool same = (j < clothL) & (P[j] == phk);
+        const uint32_t jj = same ? j : static_cast<uint32_t>(k);
+        const float cosKJ = C[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
+        const float osj = OS[jj];
+        const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f);  // j sheds into k
+        const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f);    // k sheds into j
+        // outScale_u * rawFlow(u), rawFlow = rate (cos theta_lu V_u W) EW_u
+        const double in = static_cast<double>(osj) * (rateL * static_cast<double>(cosKJ * (VL[jj] * W[e])) * B[jj]);
+        const double out = static_cast<double>(osk) * (rateL * static_cast<double>(-cosKJ * (vk * W[e])) * bk);
+        T[e] = in * (fromJ ? 1.0 : 0.0) - out * (toJ ? 1.0 : 0.0);  // in, -out or +-0
+      }
+      double d = 0.0;
+      for (uint32_t e = 0; e < count; ++e) d += T[e];
       s.delta[k] = d;
     });
   } else {

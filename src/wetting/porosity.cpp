@@ -6,6 +6,7 @@
 #include "core/parallel.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace soak {
 
@@ -84,12 +85,108 @@ void computeSaturation(const Model& model, const State& state, const WettingScra
   parallelFor(nc, [&](int64_t i) { sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]); });
 }
 
+// The pair loop is written for `omp simd` (plain floats, selects, gathers of j's position and radius)
+// and computes each value with the arithmetic of the scalar functions it replaces, in the same order
+// (Eigen's squaredNorm and dot of a Vec3 are x + (y + z)): poly6(), viscosityLaplacian(), spikyGrad()
+// and cosGravity() at (x_i - x_j, pairRadius(h_i, h_j)) give bit for bit the stored values. Only
+// values are stored, no sums, so the vector width changes nothing.
+namespace {
+
+// pairGeometry, then after(i) for each cloth particle i in the same parallel loop (one fork and join)
+template <class After>
+void pairGeometryThen(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s,
+                      After&& after) {
+  const int64_t nc = model.numCloth;
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const size_t entries = nb.index.size();
+  s.pairPoly6.resize(entries);
+  s.pairLap.resize(entries);
+  s.pairCos.resize(entries);
+  s.pairSpiky.resize(entries);
+  const Vec3 g = gravityDirection(model);
+  const float gx = g.x(), gy = g.y(), gz = g.z();
+  const float* const x = p.x[0].data();
+  const float* const radius = p.radius.data();
+  const uint32_t* const list = nb.index.data();
+  float* const poly6s = s.pairPoly6.data();
+  float* const laps = s.pairLap.data();
+  float* const coss = s.pairCos.data();
+  float* const spikys = s.pairSpiky.data();
+  parallelFor(nc, [&](int64_t i) {
+    // local copies: GCC does not vectorise loads through the closure's references
+    const float* const X = x;
+    const float* const H = radius;
+    const uint32_t* const index = list;
+    float* const P6 = poly6s;
+    float* const L = laps;
+    float* const C = coss;
+    float* const F = spikys;
+    const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i];
+    const uint32_t begin = nb.start[i], end = nb.clothEnd(i, cloth);
+#pragma omp simd
+    for (uint32_t e = begin; e < end; ++e) {
+      const uint32_t j = index[e];
+      const float dx = xi - X[3 * j], dy = yi - X[3 * j + 1], dz = zi - X[3 * j + 2];
+      const float r2 = dx * dx + (dy * dy + dz * dz);
+      const float h = 0.5f * (hi + H[j]);  // pairRadius
+      // poly6(r2, h)
+      const float h2 = h * h;
+      const float dq = h2 - r2;
+      const float h9 = h2 * h2 * h2 * h2 * h;
+      P6[e] = r2 >= h2 ? 0.0f : 315.0f / (64.0f * kPi * h9) * dq * dq * dq;
+      // cosGravity(x_i, x_j, g); rCos and rGrad are r where the value is kept and only guard the
+      // divisions of the lanes the selects drop (no std::max: it returns a reference, a memory load)
+      const float r = std::sqrt(r2);
+      const float dot = dx * gx + (dy * gy + dz * gz);
+      const float rCos = r > 1e-12f ? r : 1.0f;
+      C[e] = r > 1e-12f ? dot / rCos : 0.0f;
+      // viscosityLaplacian(r, h) and the factor of spikyGrad(x_i - x_j, h)
+      const float h3 = h * h * h;
+      const float dh = h - r;
+      L[e] = r >= h ? 0.0f : 45.0f / (kPi * h3 * h3) * dh;
+      const bool inGrad = (r < h) & (r > 1e-9f);
+      const float rGrad = inGrad ? r : 1.0f;
+      F[e] = inGrad ? -45.0f / (kPi * h3 * h3) * dh * dh / rGrad : 0.0f;
+    }
+    after(i);
+  });
+  s.pairsList = nb.index.data();
+  s.pairsSize = entries;
+  s.pairsValid = true;
+}
+
+}  // namespace
+
+void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s) {
+  pairGeometryThen(model, p, nb, s, [](int64_t) {});
+}
+
+void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s) {
+  if (s.pairsValid && s.pairsList == nb.index.data() && s.pairsSize == nb.index.size()) return;
+  pairGeometry(model, p, nb, s);
+}
+
 void updatePorosity(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s) {
   if (!model.wetting.enabled || model.numCloth == 0) return;
   const Particles& p = state.particles;
-  clothVolumes(model, p.x, p.radius, p.phase, nb, s.volume);
-  computeSaturation(model, state, s, state.clothSaturation);
-  parallelFor(model.numCloth, [&](int64_t i) { setWetMass(model, state, i); });
+  const int64_t nc = model.numCloth;
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const double c = model.wetting.c;
+  s.volume.resize(static_cast<size_t>(nc));
+  state.clothSaturation.resize(static_cast<size_t>(nc));
+  // in the loop of the pair geometry, once i's pairs are done: V_i = 1 / sum_k W_ik (Eq. 10) as
+  // clothVolumes (the same terms in the same order), S_i as computeSaturation, and the wet mass
+  pairGeometryThen(model, p, nb, s, [&](int64_t i) {
+    float sum = poly6(0.0f, p.radius[i]);  // k includes i itself
+    for (uint32_t e = nb.start[i], end = nb.clothEnd(i, cloth); e < end; ++e) {
+      const uint32_t j = nb.index[e];
+      if (static_cast<int64_t>(j) >= nc || p.phase[j] != p.phase[i]) continue;  // same piece only
+      sum += s.pairPoly6[e];
+    }
+    s.volume[i] = 1.0f / sum;
+    state.clothSaturation[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+    setWetMass(model, state, i);
+  });
 }
 
 }  // namespace soak

@@ -32,10 +32,10 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
   const std::vector<float>& sat = state.clothSaturation;
   s.force.resize(static_cast<size_t>(nc));
   // gathered per particle; the pair's force is bit for bit opposite seen from the other side
-  parallelFor(nc, [&](int64_t i) {
+  parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     Vec3 f = Vec3::Zero();
     if (sat[i] > 0.0f) {
-      for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
+      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, static_cast<uint32_t>(nc)); e < end; ++e) {
         const int64_t j = nb.index[e];
         if (j >= nc || !(sat[j] > 0.0f)) continue;
         const float hij = pairRadius(p.radius[i], p.radius[j]);

@@ -20,6 +20,20 @@
 
 namespace soak {
 
+// cloth particles per chunk of the wetting loops scheduled dynamically (parallelForDynamic): the wet
+// part of a cloth costs far more per particle than the dry part, and is rarely split evenly
+constexpr int64_t kWetChunk = 256;
+
+// a per-thread buffer of at least n values, for the per-pair terms of one particle's neighbour loop:
+// a vectorised loop writes them, a scalar loop then sums them in list order (the order of the sums
+// stays that of the scalar code, and with it every result)
+template <class T>
+inline T* threadBuffer(size_t n) {
+  thread_local std::vector<T> buffer;
+  if (buffer.size() < n) buffer.resize(n);
+  return buffer.data();
+}
+
 // scratch of the wetting stages, reused from substep to substep
 struct WettingScratch {
   std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this substep
@@ -36,6 +50,17 @@ struct WettingScratch {
   std::vector<float> outScale;     // keeps a buffer's outflow within the buffer (Eq. 18)
   std::vector<int64_t> dripOf;     // index of the drip hanging from each cloth particle, -1 when none
   std::vector<Vec3> force;         // N, sticking force per cloth particle (Eq. 20)
+  // geometry of the cloth pairs at this substep's positions x (pairGeometry), one value per entry e of
+  // the cloth part [start[i], clothEnd(i)) of a cloth particle i's neighbour list, j = index[e], with
+  // h_ij = pairRadius(h_i, h_j) and x_ij = x_i - x_j; the other entries are not set. Porosity,
+  // diffusion and emission read them instead of each taking a norm and divisions per pair.
+  std::vector<float> pairPoly6;    // W_poly6(|x_ij|^2, h_ij) (Eq. 10, Eq. 18)
+  std::vector<float> pairLap;      // lap W_visc(|x_ij|, h_ij) (Eq. 12)
+  std::vector<float> pairCos;      // cos theta_ij = cosGravity(x_i, x_j, g); exactly -cos theta_ji
+  std::vector<float> pairSpiky;    // f of grad W_spiky(x_ij, h_ij) = f x_ij (Eq. 18)
+  bool pairsValid = false;         // set by updatePorosity, cleared by finishWetting
+  const uint32_t* pairsList = nullptr;  // nb.index.data() of the lists they were computed for
+  size_t pairsSize = 0;                 // and its size
 };
 
 // a rate per rateStep (0..1, a fraction removed per step) converted to a step of h seconds, so that n
@@ -76,6 +101,14 @@ void clothVolumes(const Model& model, const std::vector<Vec3>& x, const std::vec
 // Eq. 10 at this substep's positions: V_i, S_i = c m^water_i / V_i, and the wet mass
 // m_i = dry + held + buffer (pinned particles keep inverse mass 0)
 void updatePorosity(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s);
+
+// fills the pair geometry of the scratch (WettingScratch::pairPoly6 ...) for the cloth pairs of nb at
+// the positions p.x (one vectorised pass); updatePorosity calls it, and diffusion and emission call
+// ensurePairGeometry, which computes it only when the scratch holds none for these lists (a stage
+// run on its own, as in the tests). Positions must not change between updatePorosity and the stages
+// that read the pairs (they do not in a substep: x is committed before the wetting stages).
+void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
+void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
 
 // S_i = c m / V_i for the held water of every cloth particle
 void computeSaturation(const Model& model, const State& state, const WettingScratch& s, std::vector<float>& sat);
