@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <set>
+#include <vector>
 
 namespace soak {
 
@@ -35,9 +37,63 @@ const char* typeName(const Json& v) {
 
 }  // namespace
 
+namespace {
+
+// the parser's path through the document, to name a key that an object repeats: nlohmann keeps the
+// last value of a repeated key, so a scene that sets a key twice would lose the first silently
+struct DuplicateKeys {
+  struct Frame {
+    bool array = false;
+    int index = 0;          // arrays: elements started so far
+    std::string key;        // objects: the key being read
+    std::set<std::string> keys;
+  };
+  std::vector<Frame> frames;
+  std::string duplicate;    // the JSON path of the first repeated key, empty if none
+
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : frames) {
+      if (f.array) out += fmt::format("[{}]", f.index - 1);
+      else if (!f.key.empty()) out += (out.empty() ? "" : ".") + f.key;
+    }
+    return out;
+  }
+  void element() {  // a value starts: in an array it is the next element
+    if (!frames.empty() && frames.back().array) ++frames.back().index;
+  }
+  bool operator()(int, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start:
+      case Json::parse_event_t::array_start:
+        element();
+        frames.push_back({event == Json::parse_event_t::array_start, 0, {}, {}});
+        break;
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        if (!frames.empty()) frames.pop_back();
+        break;
+      case Json::parse_event_t::key: {
+        Frame& f = frames.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second && duplicate.empty()) duplicate = path();
+        break;
+      }
+      case Json::parse_event_t::value:
+        element();
+        break;
+    }
+    return true;
+  }
+};
+
+}  // namespace
+
 Json parseSceneJson(const std::string& text, const std::string& file) {
+  DuplicateKeys keys;
+  Json doc;
   try {
-    return Json::parse(text, nullptr, true, true);
+    doc = Json::parse(text, std::ref(keys), true, true);
   } catch (const Json::parse_error& e) {
     // e.byte is the 1-based offset of the offending character; count lines up to it ourselves
     const size_t end = std::min(text.size(), e.byte > 0 ? size_t(e.byte - 1) : size_t(0));
@@ -55,6 +111,9 @@ Json parseSceneJson(const std::string& text, const std::string& file) {
     if (syntax != std::string::npos) what = what.substr(syntax);
     throw errorAt(file, fmt::format("line {}, column {}", line, column), "invalid JSON: " + what);
   }
+  if (!keys.duplicate.empty())
+    throw errorAt(file, keys.duplicate, "expected each key once in its object, got it twice (JSON keeps only the last)");
+  return doc;
 }
 
 void applyOverrides(Json& doc, const std::vector<std::string>& overrides, const std::string& file) {

@@ -8,7 +8,8 @@
 namespace soak {
 
 // parses JSON text (comments allowed); a syntax error throws soak::Error
-// "<file>: at line L, column C: invalid JSON: <what>"
+// "<file>: at line L, column C: invalid JSON: <what>", a key repeated in one object
+// "<file>: at <path>: expected each key once in its object, ..."
 Json parseSceneJson(const std::string& text, const std::string& file);
 
 // applies "a.b.0.c=value" overrides in order: walks the path (numeric components index arrays,

@@ -390,6 +390,19 @@ TEST(SceneErrors, NonManifoldObjIsRefusedWithFileAndPath) {
   }
 }
 
+TEST(SceneErrors, ARepeatedKeyIsNamedWithItsPath) {
+  // JSON parsers keep the last of two equal keys: the first value would be lost without a word
+  EXPECT_HAS(loadError(R"({"solver": {"dt": 0.015, "substeps": 2, "dt": 0.01}})"),
+             "test.json: at solver.dt: expected each key once in its object, got it twice");
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle"}},
+                                     {"mesh": {"type": "rectangle"}, "material": {"thickness": 0.01, "thickness": 0.02}}]})"),
+             "test.json: at cloth[1].material.thickness: expected each key once");
+  // the same key in two objects is not a repeat
+  EXPECT_EQ(loadError(R"({"cloth": [{"name": "a", "mesh": {"type": "rectangle", "size": [0.2, 0.2], "resolution": [3, 3]}},
+                                    {"name": "b", "mesh": {"type": "rectangle", "size": [0.2, 0.2], "resolution": [3, 3]}}]})"),
+            "");
+}
+
 TEST(SceneErrors, JsonSyntaxErrorNamesLineAndColumn) {
   const std::string msg = loadError("{\n  \"solver\": {\n    \"dt\": 0.01,\n  }\n}\n");
   EXPECT_HAS(msg, "test.json: at line 4, column 3: invalid JSON: syntax error");
