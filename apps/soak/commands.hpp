@@ -12,7 +12,7 @@ class Option;
 
 namespace soak::cli {
 
-inline constexpr const char* kVersion = "0.1.0";
+inline constexpr const char* kVersion = SOAK_VERSION;  // project(soak VERSION ...) in CMakeLists.txt
 
 // exit codes: 0 success, 1 bad input or I/O error (nothing or little was done), 2 the simulation
 // diverged (checkState failed; the bad frame was written)

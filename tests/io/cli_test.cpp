@@ -222,7 +222,7 @@ TEST(CliVersion, PrintsTheVersion) {
   const Cli cli("version");
   const Result r = cli.run("--version");
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("soak 0."), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(std::string("soak ") + SOAK_VERSION + "\n"), std::string::npos) << r.out;  // CMake's project version
   EXPECT_EQ(cli.run("").code, 1);              // no subcommand
   EXPECT_EQ(cli.run("run --frames 2").code, 1);  // no scene, no -o
 }
