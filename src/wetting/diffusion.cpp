@@ -130,7 +130,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
     // the exchange, and S_i for the next iteration or stage (computeSaturation, in the same loop)
     parallelFor(nc, [&](int64_t i) {
       state.clothWater[i] = std::max(0.0, state.clothWater[i] + s.delta[i]);
-      sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+      sat[i] = saturationOf(c, state.clothWater[i], s.volume[i]);
     });
   }
 }

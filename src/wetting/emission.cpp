@@ -84,7 +84,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       state.clothWater[i] = keep;
       state.clothBuffer[i] += excess;
     }
-    sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+    sat[i] = saturationOf(c, state.clothWater[i], s.volume[i]);
   });
   const uint32_t cloth = static_cast<uint32_t>(nc);  // loops below read the cloth part of the lists
 

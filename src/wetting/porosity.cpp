@@ -82,7 +82,7 @@ void computeSaturation(const Model& model, const State& state, const WettingScra
   const int64_t nc = model.numCloth;
   const double c = model.wetting.c;
   sat.resize(static_cast<size_t>(nc));
-  parallelFor(nc, [&](int64_t i) { sat[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]); });
+  parallelFor(nc, [&](int64_t i) { sat[i] = saturationOf(c, state.clothWater[i], s.volume[i]); });
 }
 
 // The pair loop is written for `omp simd` (plain floats, selects, gathers of j's position and radius)
@@ -184,7 +184,7 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
       sum += s.pairPoly6[e];
     }
     s.volume[i] = 1.0f / sum;
-    state.clothSaturation[i] = static_cast<float>(c * state.clothWater[i] / s.volume[i]);
+    state.clothSaturation[i] = saturationOf(c, state.clothWater[i], s.volume[i]);
     setWetMass(model, state, i);
   });
 }

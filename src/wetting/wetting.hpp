@@ -110,6 +110,10 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
 void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
 void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
 
+// S_i = c m / V_i (Eq. 10) of one cloth particle: the one expression every stage that changes the held
+// water uses, so S_i is bit for bit the same wherever it is updated
+inline float saturationOf(double c, double heldWater, float volume) { return static_cast<float>(c * heldWater / volume); }
+
 // S_i = c m / V_i for the held water of every cloth particle
 void computeSaturation(const Model& model, const State& state, const WettingScratch& s, std::vector<float>& sat);
 
