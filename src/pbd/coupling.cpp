@@ -79,6 +79,48 @@ void smoothStartNormals(const Model& model, const Particles& p, CouplingScratch&
   });
 }
 
+// the cloth particles 0 .. nc at their predicted positions in a dense grid of the given cell size over
+// their bounding box; a sheet spread over a large volume gets coarser cells rather than a large table
+void buildClothBoxGrid(const Particles& p, int64_t nc, float cell, ClothBoxGrid& g) {
+  Vec3 lo = p.xPred[0], hi = p.xPred[0];
+  for (int64_t j = 1; j < nc; ++j) {
+    lo = lo.cwiseMin(p.xPred[j]);
+    hi = hi.cwiseMax(p.xPred[j]);
+  }
+  const double maxCells = 4.0 * static_cast<double>(nc) + 4096.0;
+  for (;;) {
+    const Vec3 span = (hi - lo) / cell;
+    g.dims = {static_cast<int>(span.x()) + 1, static_cast<int>(span.y()) + 1, static_cast<int>(span.z()) + 1};
+    if (static_cast<double>(g.dims.x()) * g.dims.y() * g.dims.z() <= maxCells) break;
+    cell *= 2.0f;
+  }
+  g.cell = cell;
+  g.origin = lo;
+  const size_t cells = static_cast<size_t>(g.dims.x()) * g.dims.y() * g.dims.z();
+  g.cellOf.resize(static_cast<size_t>(nc));
+  parallelFor(nc, [&](int64_t j) {
+    const Eigen::Vector3i c = g.clampedCell(p.xPred[j]);
+    g.cellOf[j] = g.index(c.x(), c.y(), c.z());
+  });
+  // counting sort, ascending particle order inside a cell
+  g.cellStart.assign(cells + 1, 0);
+  for (int64_t j = 0; j < nc; ++j) ++g.cellStart[g.cellOf[j] + 1];
+  for (size_t c = 0; c < cells; ++c) g.cellStart[c + 1] += g.cellStart[c];
+  g.entry.resize(static_cast<size_t>(nc));
+  g.px.resize(static_cast<size_t>(nc));
+  g.py.resize(static_cast<size_t>(nc));
+  g.pz.resize(static_cast<size_t>(nc));
+  for (int64_t j = 0; j < nc; ++j) {
+    const uint32_t e = g.cellStart[g.cellOf[j]]++;
+    g.entry[e] = static_cast<uint32_t>(j);
+    g.px[e] = p.xPred[j].x();
+    g.py[e] = p.xPred[j].y();
+    g.pz[e] = p.xPred[j].z();
+  }
+  for (size_t c = cells; c > 0; --c) g.cellStart[c] = g.cellStart[c - 1];
+  g.cellStart[0] = 0;
+}
+
 }  // namespace
 
 float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const Vec3& xc, float side, float thickness,
@@ -115,21 +157,27 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     const float l0 = n0.norm();
     s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
   });
-  // a grid of the cloth alone at its predicted positions (the solvers have moved them since the
-  // neighbour search), and the box around the sheet that a path must touch to meet it
-  s.clothPos.assign(p.xPred.begin(), p.xPred.begin() + nc);
-  float hCloth = 0.0f;
-  Vec3 lo = s.clothPos[0], hi = s.clothPos[0];
+  // how far from a water particle's path a cloth particle can be and still have a triangle that
+  // the passes may find within d of the path: d and half of it (the lateral allowance of a contact)
+  // and a margin of d/2, the farthest a point of a triangle can be from its nearest corner (L / sqrt 3
+  // for the longest edge L), and the farthest a cloth particle moved in this substep (a triangle
+  // that swept past a slow particle ends up beside it). At most the old bound (h_q + h_cloth) / 2
+  float hCloth = 0.0f, shift2 = 0.0f, edge2 = 0.0f, thickness = 0.0f;
   for (int64_t j = 0; j < nc; ++j) {
     hCloth = std::max(hCloth, p.radius[j]);
-    lo = lo.cwiseMin(s.clothPos[j]);
-    hi = hi.cwiseMax(s.clothPos[j]);
+    shift2 = std::max(shift2, (p.xPred[j] - p.x[j]).squaredNorm());
   }
-  const float cell = std::max(hCloth, model.water.supportRadius);
-  buildGrid(s.clothPos, cell, s.clothGrid);
-  lo.array() -= cell;
-  hi.array() += cell;
-  const NeighborGrid& grid = s.clothGrid;
+  for (const auto& f : model.triangles)
+    edge2 = std::max({edge2, (p.xPred[f[0]] - p.xPred[f[1]]).squaredNorm(), (p.xPred[f[1]] - p.xPred[f[2]]).squaredNorm(),
+                      (p.xPred[f[2]] - p.xPred[f[0]]).squaredNorm()});
+  for (const auto& piece : model.pieces) thickness = std::max(thickness, piece.material.thickness);
+  const float reachAll = 2.0f * thickness + std::sqrt(edge2 / 3.0f) + std::sqrt(shift2);
+  const float reachMax = std::min(reachAll, std::max(hCloth, model.water.supportRadius));
+  // the cloth alone at its predicted positions (the solvers have moved it since the neighbour search)
+  buildClothBoxGrid(p, nc, std::max(reachMax, 1e-4f), s.clothGrid);
+  const ClothBoxGrid& grid = s.clothGrid;
+  const Vec3 lo = grid.origin, hi = grid.origin + grid.dims.cast<float>() * grid.cell;
+  s.nearestCloth.resize(static_cast<size_t>(nw));
   const int nThreads = omp_get_max_threads();
   s.seen.resize(static_cast<size_t>(nThreads));
   s.seenCloth.resize(static_cast<size_t>(nThreads));
@@ -150,37 +198,39 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     for (int64_t w = begin; w < end; ++w) {
       const int64_t q = nc + w;
       const Vec3 a = p.x[q], ab = p.xPred[q] - a;
-      const float reach = std::min(0.5f * (p.radius[q] + hCloth), cell);
-      const bool nearSheet = (a.cwiseMin(p.xPred[q]).array() <= hi.array()).all() &&
-                             (a.cwiseMax(p.xPred[q]).array() >= lo.array()).all();
-      // the path in pieces no longer than a cell, each piece's box of cells (at most 4 per axis)
+      const float reach = std::min(reachAll, 0.5f * (p.radius[q] + hCloth));
       const float len2 = ab.squaredNorm();
-      const int pieces = nearSheet ? std::max(1, static_cast<int>(std::ceil(std::sqrt(len2) / cell))) : 0;
+      float nearest2 = std::numeric_limits<float>::max();
+      int32_t nearest = -1;
+      // the path in pieces no longer than a cell; each piece's box of cells, row by row (one range each)
+      const int pieces = std::max(1, static_cast<int>(std::ceil(std::sqrt(len2) / grid.cell)));
       for (int k = 0; k < pieces; ++k) {
         const Vec3 p0 = a + ab * (static_cast<float>(k) / pieces), p1 = a + ab * (static_cast<float>(k + 1) / pieces);
-        const Eigen::Vector3i c0 = grid.cellOf(Vec3(p0.cwiseMin(p1).array() - reach)),
-                              c1 = grid.cellOf(Vec3(p0.cwiseMax(p1).array() + reach));
+        const Vec3 boxLo = p0.cwiseMin(p1).array() - reach, boxHi = p0.cwiseMax(p1).array() + reach;
+        if ((boxHi.array() < lo.array()).any() || (boxLo.array() > hi.array()).any()) continue;  // clear of the sheet
+        const Eigen::Vector3i c0 = grid.clampedCell(boxLo), c1 = grid.clampedCell(boxHi);
         for (int cz = c0.z(); cz <= c1.z(); ++cz)
           for (int cy = c0.y(); cy <= c1.y(); ++cy)
-            for (int cx = c0.x(); cx <= c1.x(); ++cx) {
-              const uint32_t b = grid.bucketOf({cx, cy, cz});
-              for (uint32_t e = grid.cellStart[b]; e < grid.cellStart[b + 1]; ++e) {
-                const uint32_t j = grid.cellEntries[e];
-                if (seenCloth[j] == static_cast<uint32_t>(q)) continue;
-                seenCloth[j] = static_cast<uint32_t>(q);
-                // distance from cloth particle j to the path
-                const Vec3 aj = s.clothPos[j] - a;
-                const float u = len2 > 0.0f ? std::clamp(aj.dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
-                if ((aj - u * ab).squaredNorm() >= reach * reach) continue;
-                for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
-                  const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
-                  if (seen[tri] == static_cast<uint32_t>(q)) continue;
-                  seen[tri] = static_cast<uint32_t>(q);
-                  if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
-                }
+            for (uint32_t e = grid.cellStart[grid.index(c0.x(), cy, cz)], e1 = grid.cellStart[grid.index(c1.x(), cy, cz) + 1];
+                 e < e1; ++e) {
+              const uint32_t j = grid.entry[e];
+              if (seenCloth[j] == static_cast<uint32_t>(q)) continue;
+              // distance from cloth particle j to the path
+              const Vec3 aj = Vec3(grid.px[e], grid.py[e], grid.pz[e]) - a;
+              const float u = len2 > 0.0f ? std::clamp(aj.dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
+              if ((aj - u * ab).squaredNorm() >= reach * reach) continue;
+              seenCloth[j] = static_cast<uint32_t>(q);
+              const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
+              if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
+              for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
+                const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
+                if (seen[tri] == static_cast<uint32_t>(q)) continue;
+                seen[tri] = static_cast<uint32_t>(q);
+                if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
               }
             }
       }
+      s.nearestCloth[static_cast<size_t>(w)] = nearest;
       s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
     }
     offset[static_cast<size_t>(t) + 1] = out.size();
@@ -205,13 +255,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   parallelFor(nw, [&](int64_t w) {
     const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
     const uint32_t c0 = s.candidateStart[static_cast<size_t>(w)], c1 = s.candidateStart[static_cast<size_t>(w) + 1];
-    float nearest2 = std::numeric_limits<float>::max();
-    int nearest = -1;
-    for (uint32_t c = c0; c < c1; ++c)
-      for (int v : model.triangles[s.candidates[c]]) {
-        const float d2 = (xq0 - p.x[v]).squaredNorm();
-        if (d2 < nearest2) nearest2 = d2, nearest = v;
-      }
+    const int32_t nearest = s.nearestCloth[static_cast<size_t>(w)];
     const float sheetSide = nearest < 0 || (xq0 - p.x[nearest]).dot(s.sheetNormal[nearest]) >= 0.0f ? 1.0f : -1.0f;
     for (uint32_t c = c0; c < c1; ++c) {
       const uint32_t tri = s.candidates[c];

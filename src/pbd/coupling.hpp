@@ -6,6 +6,7 @@
 
 #include "grid/grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -16,12 +17,35 @@ struct CouplingContact {
   Vec3 da, db, dc;   // m, corrections of the triangle's vertices
 };
 
+// the cloth particles in a dense grid over the sheet's bounding box, sorted by cell (x fastest), so
+// that the cells of one row of a box are one range of the sorted arrays; positions copied in that
+// order for the path tests
+struct ClothBoxGrid {
+  float cell = 0.0f;                         // m
+  Vec3 origin = Vec3::Zero();                // m, corner of cell (0, 0, 0)
+  Eigen::Vector3i dims{0, 0, 0};
+  std::vector<uint32_t> cellStart;           // size cells + 1
+  std::vector<uint32_t> entry;               // cloth particle of each sorted slot
+  std::vector<uint32_t> cellOf;              // per cloth particle: its dense cell
+  std::vector<float> px, py, pz;             // m, positions in slot order
+  // the cell of x clamped to the grid
+  Eigen::Vector3i clampedCell(const Vec3& x) const {
+    const Vec3 c = (x - origin) / cell;
+    return {std::clamp(static_cast<int>(std::floor(c.x())), 0, dims.x() - 1),
+            std::clamp(static_cast<int>(std::floor(c.y())), 0, dims.y() - 1),
+            std::clamp(static_cast<int>(std::floor(c.z())), 0, dims.z() - 1)};
+  }
+  uint32_t index(int x, int y, int z) const {
+    return static_cast<uint32_t>((z * dims.y() + y) * dims.x() + x);
+  }
+};
+
 struct CouplingScratch {
   std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
   std::vector<std::vector<uint32_t>> seenCloth;  // per thread: the water particle that last tested a cloth particle
-  std::vector<Vec3> clothPos;                // m, the cloth's predicted positions the cloth grid was built on
-  NeighborGrid clothGrid;                    // the cloth particles alone, for the water's paths
+  ClothBoxGrid clothGrid;                    // the cloth particles alone at their predicted positions
+  std::vector<int32_t> nearestCloth;         // per water particle: the cloth particle nearest its start (-1: none)
   std::vector<std::vector<uint32_t>> perThreadCandidates;
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
