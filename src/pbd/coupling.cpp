@@ -79,9 +79,9 @@ void smoothStartNormals(const Model& model, const Particles& p, CouplingScratch&
   });
 }
 
-// the cloth particles 0 .. nc at their predicted positions in a dense grid of the given cell size over
+// the cloth particles 0 .. nc at their predicted positions (and their reach) in a dense grid of the given cell size over
 // their bounding box; a sheet spread over a large volume gets coarser cells rather than a large table
-void buildClothBoxGrid(const Particles& p, int64_t nc, float cell, ClothBoxGrid& g) {
+void buildClothBoxGrid(const Particles& p, const std::vector<float>& reach, int64_t nc, float cell, ClothBoxGrid& g) {
   Vec3 lo = p.xPred[0], hi = p.xPred[0];
   for (int64_t j = 1; j < nc; ++j) {
     lo = lo.cwiseMin(p.xPred[j]);
@@ -110,12 +110,14 @@ void buildClothBoxGrid(const Particles& p, int64_t nc, float cell, ClothBoxGrid&
   g.px.resize(static_cast<size_t>(nc));
   g.py.resize(static_cast<size_t>(nc));
   g.pz.resize(static_cast<size_t>(nc));
+  g.pr.resize(static_cast<size_t>(nc));
   for (int64_t j = 0; j < nc; ++j) {
     const uint32_t e = g.cellStart[g.cellOf[j]]++;
     g.entry[e] = static_cast<uint32_t>(j);
     g.px[e] = p.xPred[j].x();
     g.py[e] = p.xPred[j].y();
     g.pz[e] = p.xPred[j].z();
+    g.pr[e] = reach[j];
   }
   for (size_t c = cells; c > 0; --c) g.cellStart[c] = g.cellStart[c - 1];
   g.cellStart[0] = 0;
@@ -157,24 +159,35 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     const float l0 = n0.norm();
     s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
   });
-  // how far from a water particle's path a cloth particle can be and still have a triangle that
+  // how far from a water particle's path each cloth particle j can be and still have a triangle that
   // the passes may find within d of the path: d and half of it (the lateral allowance of a contact)
-  // and a margin of d/2, the farthest a point of a triangle can be from its nearest corner (L / sqrt 3
-  // for the longest edge L), and the farthest a cloth particle moved in this substep (a triangle
-  // that swept past a slow particle ends up beside it). At most the old bound (h_q + h_cloth) / 2
-  float hCloth = 0.0f, shift2 = 0.0f, edge2 = 0.0f, thickness = 0.0f;
-  for (int64_t j = 0; j < nc; ++j) {
-    hCloth = std::max(hCloth, p.radius[j]);
-    shift2 = std::max(shift2, (p.xPred[j] - p.x[j]).squaredNorm());
-  }
-  for (const auto& f : model.triangles)
-    edge2 = std::max({edge2, (p.xPred[f[0]] - p.xPred[f[1]]).squaredNorm(), (p.xPred[f[1]] - p.xPred[f[2]]).squaredNorm(),
-                      (p.xPred[f[2]] - p.xPred[f[0]]).squaredNorm()});
-  for (const auto& piece : model.pieces) thickness = std::max(thickness, piece.material.thickness);
-  const float reachAll = 2.0f * thickness + std::sqrt(edge2 / 3.0f) + std::sqrt(shift2);
-  const float reachMax = std::min(reachAll, std::max(hCloth, model.water.supportRadius));
+  // and a margin of d/2; the farthest a point of a triangle can be from its nearest corner (L / sqrt 3
+  // for the longest edge L of j's triangles); and the farthest j or a particle of its 1-ring moved in
+  // this substep (a triangle that swept past a slow particle ends up beside it). At most the old
+  // bound (h_q + h_cloth) / 2
+  float hCloth = 0.0f;
+  for (int64_t j = 0; j < nc; ++j) hCloth = std::max(hCloth, p.radius[j]);
+  s.vertexReach.resize(static_cast<size_t>(nc));
+  parallelFor(nc, [&](int64_t j) {
+    float shift2 = (p.xPred[j] - p.x[j]).squaredNorm(), edge2 = 0.0f;
+    for (int k = model.vertexNeighborStart[j]; k < model.vertexNeighborStart[j + 1]; ++k) {
+      const int v = model.vertexNeighbors[k];
+      shift2 = std::max(shift2, (p.xPred[v] - p.x[v]).squaredNorm());
+    }
+    for (int k = model.vertexTriangleStart[j]; k < model.vertexTriangleStart[j + 1]; ++k) {
+      const auto& f = model.triangles[static_cast<size_t>(model.vertexTriangles[k])];
+      edge2 = std::max({edge2, (p.xPred[f[0]] - p.xPred[f[1]]).squaredNorm(), (p.xPred[f[1]] - p.xPred[f[2]]).squaredNorm(),
+                        (p.xPred[f[2]] - p.xPred[f[0]]).squaredNorm()});
+    }
+    const float thickness = model.pieces[clothPiece(p.phase[j])].material.thickness;
+    s.vertexReach[j] = 2.0f * thickness + std::sqrt(edge2 / 3.0f) + std::sqrt(shift2);
+  });
+  const float reachCap = std::max(hCloth, model.water.supportRadius);
+  float reachMax = 0.0f;
+  for (int64_t j = 0; j < nc; ++j) reachMax = std::max(reachMax, s.vertexReach[j]);
+  reachMax = std::min(reachMax, reachCap);
   // the cloth alone at its predicted positions (the solvers have moved it since the neighbour search)
-  buildClothBoxGrid(p, nc, std::max(reachMax, 1e-4f), s.clothGrid);
+  buildClothBoxGrid(p, s.vertexReach, nc, std::max(reachMax, 1e-4f), s.clothGrid);
   const ClothBoxGrid& grid = s.clothGrid;
   const Vec3 lo = grid.origin, hi = grid.origin + grid.dims.cast<float>() * grid.cell;
   s.nearestCloth.resize(static_cast<size_t>(nw));
@@ -198,7 +211,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     for (int64_t w = begin; w < end; ++w) {
       const int64_t q = nc + w;
       const Vec3 a = p.x[q], ab = p.xPred[q] - a;
-      const float reach = std::min(reachAll, 0.5f * (p.radius[q] + hCloth));
+      const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
       const float len2 = ab.squaredNorm();
       float nearest2 = std::numeric_limits<float>::max();
       int32_t nearest = -1;
@@ -218,7 +231,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
               // distance from cloth particle j to the path
               const Vec3 aj = Vec3(grid.px[e], grid.py[e], grid.pz[e]) - a;
               const float u = len2 > 0.0f ? std::clamp(aj.dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
-              if ((aj - u * ab).squaredNorm() >= reach * reach) continue;
+              const float r = std::min(reachQ, grid.pr[e]);
+              if ((aj - u * ab).squaredNorm() >= r * r) continue;
               seenCloth[j] = static_cast<uint32_t>(q);
               const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
               if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);

@@ -27,7 +27,7 @@ struct ClothBoxGrid {
   std::vector<uint32_t> cellStart;           // size cells + 1
   std::vector<uint32_t> entry;               // cloth particle of each sorted slot
   std::vector<uint32_t> cellOf;              // per cloth particle: its dense cell
-  std::vector<float> px, py, pz;             // m, positions in slot order
+  std::vector<float> px, py, pz, pr;         // m, positions and reach (findCouplingCandidates) in slot order
   // the cell of x clamped to the grid
   Eigen::Vector3i clampedCell(const Vec3& x) const {
     const Vec3 c = (x - origin) / cell;
@@ -45,6 +45,7 @@ struct CouplingScratch {
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
   std::vector<std::vector<uint32_t>> seenCloth;  // per thread: the water particle that last tested a cloth particle
   ClothBoxGrid clothGrid;                    // the cloth particles alone at their predicted positions
+  std::vector<float> vertexReach;            // m, per cloth particle: how near a path it is a candidate
   std::vector<int32_t> nearestCloth;         // per water particle: the cloth particle nearest its start (-1: none)
   std::vector<std::vector<uint32_t>> perThreadCandidates;
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
