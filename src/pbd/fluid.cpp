@@ -30,29 +30,29 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
 
 namespace {
 
-// the kernel constants of one pair, from its support radius h: one division, no h^9 divisions.
-// Written for the vectorised neighbour loops below (omp simd): no branches, only selects.
-struct PairKernel {
-  float h, h2, poly6Coef, spikyCoef;
-};
-inline PairKernel pairKernel(float h) {
-  const float inv = 1.0f / h, inv3 = inv * inv * inv, inv6 = inv3 * inv3;
-  return {h, h * h, (315.0f / (64.0f * kPi)) * inv6 * inv3, (-45.0f / kPi) * inv6};
+// the kernel constants of one pair from its support radius h, with one division and no h^9 divisions
+inline float poly6CoefOf(float inv) {
+  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+  return (315.0f / (64.0f * kPi)) * inv6 * inv3;
 }
-inline float poly6Of(const PairKernel& k, float r2) {
-  const float d = std::max(k.h2 - r2, 0.0f);
-  return k.poly6Coef * d * d * d;
+inline float spikyCoefOf(float inv) {
+  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+  return (-45.0f / kPi) * inv6;
+}
+inline float poly6Of(float h2, float poly6Coef, float r2) {
+  const float d = std::max(h2 - r2, 0.0f);
+  return poly6Coef * d * d * d;
 }
 // the factor f of grad W_spiky = f r (r = x_i - x_j), 0 outside the support and at r = 0
-inline float spikyFactorOf(const PairKernel& k, float r2) {
+inline float spikyFactorOf(float h, float spikyCoef, float r2) {
   const float len = std::sqrt(r2);
-  const float d = k.h - len;
-  return (len < k.h && len > 1e-9f) ? k.spikyCoef * d * d / std::max(len, 1e-9f) : 0.0f;
+  const float d = h - len;
+  return (len < h && len > 1e-9f) ? spikyCoef * d * d / std::max(len, 1e-9f) : 0.0f;
 }
 
 // artificial pressure s_corr = -k (W_ij / W(dq))^n (Macklin 2013 Eq. 13), in lambda units. With
 // dq = c h, W_ij / W(dq) = ((h^2 - r^2) / (h^2 (1 - c^2)))^3; the power by squaring (n < 64, the
-// scene's range), so the loop vectorises
+// scene's range), without a branch
 inline float tensileCorrection(float k, float oneMinusDq2, int n, float r2, float h2) {
   const float q = std::max(h2 - r2, 0.0f) / (h2 * oneMinusDq2);
   float base = q * q * q, power = 1.0f;
@@ -83,9 +83,11 @@ float restGradientNorm(const WaterParams& w) {
 
 }  // namespace
 
-// The neighbour loops are written for `omp simd` (gathers of j's data, reductions over the list):
-// the sum of one particle is then taken in an order fixed by the compiled code, the same for any
-// thread count, but not the order of a scalar loop (docs/performance.md).
+// The neighbour loops are scalar: vectorised (omp simd), GCC 12 emulates the gathers of j's data
+// with scalar loads on Zen 4 and the PBF passes took 19.5 ms per step at 1 thread against 17.2
+// scalar; real gather instructions (-mtune-ctrl=use_gather) were no faster (docs/performance.md).
+// (Until session 6 they carried omp simd pragmas that GCC silently did not honour: the PairKernel
+// struct in the loop body became a per-lane array.)
 void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
                 FluidScratch& s, int iterations) {
   const WaterParams& wp = model.water;
@@ -112,90 +114,101 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const int32_t* phase = p.phase.data();
   const uint32_t* index = nb.index.data();
 
-  for (int it = 0; it < iterations; ++it) {
-    // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
-    parallelFor(nw, [&](int64_t w) {
-      const size_t i = static_cast<size_t>(nc + w);
-      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
-      const float hi = H[i], mi = p.mass[i];
-      float rho = 0.0f, gx = 0.0f, gy = 0.0f, gz = 0.0f;
-      float sumOthers = 0.0f;  // sum over neighbours of w_k |grad_k C|^2
-#pragma omp simd reduction(+ : rho, gx, gy, gz, sumOthers)
-      for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
-        const uint32_t j = index[k];
-        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-        const float r2 = rx * rx + ry * ry + rz * rz;
-        const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
-        const float mj = M[j];
-        rho += mj * poly6Of(kern, r2);
-        const float f = mj * invRho0 * spikyFactorOf(kern, r2);
-        gx += f * rx;
-        gy += f * ry;
-        gz += f * rz;
-        sumOthers += W[j] * f * f * r2;
-      }
-      rho += mi * poly6(0.0f, hi);
-      Vec3 gradI(gx, gy, gz);
-      // colliders as a continuous wall of boundary particles
-      Vec3 gradWall;
-      rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi, &gradWall);
-      gradI += gradWall;
-      s.delta[i] = gradWall;  // kept for the corrections below (same positions): one wall query per iteration
-      s.density[i] = rho;
-      // inequality: only compressed water pushes, so a free surface does not clump (departure from
-      // Macklin 2013, which also pulls; see docs/models.md)
-      const float C = std::max(rho / rho0 - 1.0f, 0.0f);
-      const float denom = p.invMass[i] * gradI.squaredNorm() + sumOthers + wp.relaxation * p.invMass[i] / (hi * hi);
-      s.lambda[i] = -C / (mi * denom);
-    });
-    // water corrections: dx_i = 1/rho0 sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (+ boundaries);
-    // a cloth neighbour has lambda 0 and no s_corr: Psi_b lambda_i grad W_ib
-    parallelFor(nw, [&](int64_t w) {
-      const size_t i = static_cast<size_t>(nc + w);
-      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
-      const float hi = H[i], li = L[i];
-      float dx = 0.0f, dy = 0.0f, dz = 0.0f;
-#pragma omp simd reduction(+ : dx, dy, dz)
-      for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
-        const uint32_t j = index[k];
-        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-        const float r2 = rx * rx + ry * ry + rz * rz;
-        const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
-        const float sc = phase[j] == kWaterPhase ? sCorrK * tensileCorrection(1.0f, oneMinusDq2, tensileN, r2, kern.h2) : 0.0f;
-        const float f = M[j] * (li + L[j] + sc) * spikyFactorOf(kern, r2);
-        dx += f * rx;
-        dy += f * ry;
-        dz += f * rz;
-      }
-      s.delta[i] = (Vec3(dx, dy, dz) + rho0 * li * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
-    });
-    // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
-    parallelFor(nc, [&](int64_t b) {
-      s.delta[b].setZero();
-      if (p.invMass[b] == 0.0f) return;
-      const float xb = X[3 * b], yb = X[3 * b + 1], zb = X[3 * b + 2], hb = H[b];
-      float dx = 0.0f, dy = 0.0f, dz = 0.0f;
-      int pushing = 0;
-#pragma omp simd reduction(+ : dx, dy, dz, pushing)
-      for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1]; ++k) {
-        const uint32_t i = index[k];
-        const bool push = phase[i] == kWaterPhase && L[i] != 0.0f;
-        const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
-        const PairKernel kern = pairKernel(0.5f * (H[i] + hb));
-        const float f = push ? p.mass[i] * L[i] * spikyFactorOf(kern, rx * rx + ry * ry + rz * rz) : 0.0f;
-        dx -= f * rx;
-        dy -= f * ry;
-        dz -= f * rz;
-        pushing += push ? 1 : 0;
-      }
-      // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
-      // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
-      if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * Vec3(dx, dy, dz);
-    });
-    parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
-      if (i >= nc || p.invMass[i] != 0.0f) p.xPred[i] += s.delta[i];
-    });
-  }
+  // every particle with the same support radius (no partial absorption yet): the pair's h and 1 / h
+  // are constants of the loops, the same numbers as 0.5 (h_i + h_j) and its reciprocal
+  const auto [hMin, hMax] = std::minmax_element(p.radius.begin(), p.radius.end());
+  const float hU = *hMax, invU = 1.0f / hU;
+  const auto solve = [&](auto uniform) {
+    constexpr bool U = decltype(uniform)::value;
+    for (int it = 0; it < iterations; ++it) {
+      // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
+      parallelFor(nw, [&](int64_t w) {
+        const size_t i = static_cast<size_t>(nc + w);
+        const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+        const float hi = H[i], mi = p.mass[i];
+        float rho = 0.0f, gx = 0.0f, gy = 0.0f, gz = 0.0f;
+        float sumOthers = 0.0f;  // sum over neighbours of w_k |grad_k C|^2
+
+        for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+          const uint32_t j = index[k];
+          const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+          const float r2 = rx * rx + ry * ry + rz * rz;
+          const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
+          const float mj = M[j];
+          rho += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
+          const float f = mj * invRho0 * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
+          gx += f * rx;
+          gy += f * ry;
+          gz += f * rz;
+          sumOthers += W[j] * f * f * r2;
+        }
+        rho += mi * poly6(0.0f, hi);
+        Vec3 gradI(gx, gy, gz);
+        // colliders as a continuous wall of boundary particles
+        Vec3 gradWall;
+        rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi, &gradWall);
+        gradI += gradWall;
+        s.delta[i] = gradWall;  // kept for the corrections below (same positions): one wall query per iteration
+        s.density[i] = rho;
+        // inequality: only compressed water pushes, so a free surface does not clump (departure from
+        // Macklin 2013, which also pulls; see docs/models.md)
+        const float C = std::max(rho / rho0 - 1.0f, 0.0f);
+        const float denom = p.invMass[i] * gradI.squaredNorm() + sumOthers + wp.relaxation * p.invMass[i] / (hi * hi);
+        s.lambda[i] = -C / (mi * denom);
+      });
+      // water corrections: dx_i = 1/rho0 sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (+ boundaries);
+      // a cloth neighbour has lambda 0 and no s_corr: Psi_b lambda_i grad W_ib
+      parallelFor(nw, [&](int64_t w) {
+        const size_t i = static_cast<size_t>(nc + w);
+        const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+        const float hi = H[i], li = L[i];
+        float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+
+        for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
+          const uint32_t j = index[k];
+          const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+          const float r2 = rx * rx + ry * ry + rz * rz;
+          const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
+          const float sc = phase[j] == kWaterPhase ? sCorrK * tensileCorrection(1.0f, oneMinusDq2, tensileN, r2, kh * kh) : 0.0f;
+          const float f = M[j] * (li + L[j] + sc) * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
+          dx += f * rx;
+          dy += f * ry;
+          dz += f * rz;
+        }
+        s.delta[i] = (Vec3(dx, dy, dz) + rho0 * li * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
+      });
+      // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
+      parallelFor(nc, [&](int64_t b) {
+        s.delta[b].setZero();
+        if (p.invMass[b] == 0.0f) return;
+        const float xb = X[3 * b], yb = X[3 * b + 1], zb = X[3 * b + 2], hb = H[b];
+        float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+        int pushing = 0;
+
+        for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1]; ++k) {
+          const uint32_t i = index[k];
+          const bool push = phase[i] == kWaterPhase && L[i] != 0.0f;
+          const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
+          const float kh = U ? hU : 0.5f * (H[i] + hb), kinv = U ? invU : 1.0f / kh;
+          const float f = push ? p.mass[i] * L[i] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz) : 0.0f;
+          dx -= f * rx;
+          dy -= f * ry;
+          dz -= f * rz;
+          pushing += push ? 1 : 0;
+        }
+        // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
+        // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
+        if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * Vec3(dx, dy, dz);
+      });
+      parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
+        if (i >= nc || p.invMass[i] != 0.0f) p.xPred[i] += s.delta[i];
+      });
+    }
+  };
+  if (*hMin == *hMax)
+    solve(std::true_type{});
+  else
+    solve(std::false_type{});
 }
 
 void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt) {
@@ -220,20 +233,20 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
     const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
     const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
     float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
-#pragma omp simd reduction(+ : bx, by, bz, ox, oy, oz)
+
     for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
       const uint32_t j = index[k];
       const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
       const float r2 = rx * rx + ry * ry + rz * rz;
-      const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
+      const float kh = 0.5f * (hi + H[j]), kinv = 1.0f / kh;
       // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
       const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
       const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
-      const float wgt = vol * poly6Of(kern, r2);
+      const float wgt = vol * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
       bx += wgt * vx;
       by += wgt * vy;
       bz += wgt * vz;
-      const float f = vol * spikyFactorOf(kern, r2);  // v_ij x (f r)
+      const float f = vol * spikyFactorOf(kh, spikyCoefOf(kinv), r2);  // v_ij x (f r)
       ox += f * (vy * rz - vz * ry);
       oy += f * (vz * rx - vx * rz);
       oz += f * (vx * ry - vy * rx);
@@ -250,13 +263,13 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
       const size_t i = static_cast<size_t>(nc + w);
       const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i];
       float ex = 0.0f, ey = 0.0f, ez = 0.0f;
-#pragma omp simd reduction(+ : ex, ey, ez)
+
       for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
         const uint32_t j = index[k];
         const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-        const PairKernel kern = pairKernel(0.5f * (hi + H[j]));
+        const float kh = 0.5f * (hi + H[j]), kinv = 1.0f / kh;
         const float vol = phase[j] == kWaterPhase ? M[j] / std::max(D[j], 1e-3f) : 0.0f;
-        const float f = vol * O[j] * spikyFactorOf(kern, rx * rx + ry * ry + rz * rz);
+        const float f = vol * O[j] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz);
         ex += f * rx;
         ey += f * ry;
         ez += f * rz;
