@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace soak {
 
@@ -104,6 +105,21 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const float sCorrK = wp.tensileK * s.sCorrScale, oneMinusDq2 = 1.0f - wp.tensileDq * wp.tensileDq;
   const int tensileN = wp.tensileN;
   boundaryParts(model, poses, s.parts);
+  // each water particle's distance to the nearest collider part, once per substep; the iterations
+  // query the parts again only once the particle may have come within h of one. Factor 2 on the
+  // distance moved: a trilinear mesh distance can change faster than the point moves
+  if (!s.parts.empty()) {
+    s.wallClear.resize(static_cast<size_t>(nw));
+    s.wallFrom.resize(static_cast<size_t>(nw));
+    parallelFor(nw, [&](int64_t w) {
+      const Vec3& x = p.xPred[static_cast<size_t>(nc + w)];
+      float clear = std::numeric_limits<float>::max();
+      Vec3 normal;
+      for (const BoundaryPart& part : s.parts) clear = std::min(clear, colliderDistance(part.shape, part.pose, x, &normal));
+      s.wallClear[w] = clear;
+      s.wallFrom[w] = x;
+    });
+  }
   // the mass a neighbour lends the density: its own for water, the boundary mass Psi_b for cloth
   parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.massOrPsi[j] = j < nc ? s.psi[j] : p.mass[j]; });
   const float* X = p.xPred[0].data();
@@ -144,9 +160,11 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         }
         rho += mi * poly6(0.0f, hi);
         Vec3 gradI(gx, gy, gz);
-        // colliders as a continuous wall of boundary particles
-        Vec3 gradWall;
-        rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi, &gradWall);
+        // colliders as a continuous wall of boundary particles, skipped while the particle cannot have
+        // come within h of one (exact: a part beyond h adds nothing)
+        Vec3 gradWall = -Vec3::Zero();
+        if (!s.parts.empty() && s.wallClear[w] - 2.0f * (p.xPred[i] - s.wallFrom[w]).norm() < hi)
+          rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi, &gradWall);
         gradI += gradWall;
         s.delta[i] = gradWall;  // kept for the corrections below (same positions): one wall query per iteration
         s.density[i] = rho;

@@ -22,6 +22,8 @@ struct FluidScratch {
   std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
+  std::vector<float> wallClear;    // m, per water particle: its distance to the nearest part at wallFrom
+  std::vector<Vec3> wallFrom;      // m, where each water particle was when wallClear was measured
 };
 
 // Akinci volume of each cloth particle, V_b = 1 / sum_k W_bk over the same piece (Eq. 10), and
