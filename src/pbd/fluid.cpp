@@ -245,33 +245,46 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   const float* D = s.density.data();
   const int32_t* phase = p.phase.data();
   const uint32_t* index = nb.index.data();
-  // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), and XSPH (Eq. 17) weighted by V_ij
-  parallelFor(nw, [&](int64_t w) {
-    const size_t i = static_cast<size_t>(nc + w);
-    const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
-    const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
-    float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
-
-    for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
-      const uint32_t j = index[k];
-      const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-      const float r2 = rx * rx + ry * ry + rz * rz;
-      const float kh = 0.5f * (hi + H[j]), kinv = 1.0f / kh;
-      // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
-      const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
-      const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
-      const float wgt = vol * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
-      bx += wgt * vx;
-      by += wgt * vy;
-      bz += wgt * vz;
-      const float f = vol * spikyFactorOf(kh, spikyCoefOf(kinv), r2);  // v_ij x (f r)
-      ox += f * (vy * rz - vz * ry);
-      oy += f * (vz * rx - vx * rz);
-      oz += f * (vx * ry - vy * rx);
-    }
-    s.vorticity[i] = Vec3(ox, oy, oz);
-    vNew[i] = Vec3(vxi, vyi, vzi) + wp.viscosity * Vec3(bx, by, bz);
-  });
+  // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), only for the confinement, and XSPH
+  // (Eq. 17) weighted by V_ij. Compile-time flags: every radius equal (h and 1 / h are constants, as
+  // in solveFluid), vorticity wanted
+  const auto [hMin, hMax] = std::minmax_element(p.radius.begin(), p.radius.end());
+  const float hU = *hMax, invU = 1.0f / hU;
+  const auto xsph = [&](auto uniform, auto vortex) {
+    constexpr bool U = decltype(uniform)::value, Vort = decltype(vortex)::value;
+    parallelFor(nw, [&](int64_t w) {
+      const size_t i = static_cast<size_t>(nc + w);
+      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
+      const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
+      float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
+      for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
+        const uint32_t j = index[k];
+        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+        const float r2 = rx * rx + ry * ry + rz * rz;
+        const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
+        // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
+        const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
+        const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
+        const float wgt = vol * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
+        bx += wgt * vx;
+        by += wgt * vy;
+        bz += wgt * vz;
+        if (Vort) {
+          const float f = vol * spikyFactorOf(kh, spikyCoefOf(kinv), r2);  // v_ij x (f r)
+          ox += f * (vy * rz - vz * ry);
+          oy += f * (vz * rx - vx * rz);
+          oz += f * (vx * ry - vy * rx);
+        }
+      }
+      if (Vort) s.vorticity[i] = Vec3(ox, oy, oz);
+      vNew[i] = Vec3(vxi, vyi, vzi) + wp.viscosity * Vec3(bx, by, bz);
+    });
+  };
+  const bool uniform = *hMin == *hMax, vortex = wp.vorticity > 0.0f;
+  if (uniform && vortex) xsph(std::true_type{}, std::true_type{});
+  if (uniform && !vortex) xsph(std::true_type{}, std::false_type{});
+  if (!uniform && vortex) xsph(std::false_type{}, std::true_type{});
+  if (!uniform && !vortex) xsph(std::false_type{}, std::false_type{});
   if (wp.vorticity > 0.0f) {
     // f = epsilon (N x omega), N = eta / |eta|, eta = grad |omega| (Macklin 2013 Eq. 16)
     s.vorticityNorm.resize(n);
