@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <limits>
 #include <omp.h>
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 namespace soak {
 
@@ -41,6 +44,12 @@ Vec3 closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3&
   const float v = vb * denom, w = vc * denom;
   return {1 - v - w, v, w};
 }
+
+#if defined(__AVX512F__)
+// min and max by compare and blend (GCC 12 warns about _mm512_min_ps / _mm512_max_ps's undefined operand)
+inline __m512 minPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp_ps_mask(y, x, _CMP_LT_OQ), x, y); }
+inline __m512 maxPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp_ps_mask(x, y, _CMP_LT_OQ), x, y); }
+#endif
 
 // how far outside a triangle (in barycentric units) a point still counts as on its face
 constexpr float kFaceTolerance = 1e-3f;
@@ -215,6 +224,20 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
       const float len2 = ab.squaredNorm();
       float nearest2 = std::numeric_limits<float>::max();
       int32_t nearest = -1;
+      const float invLen2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;  // a still particle: its start point
+      // cloth particle j lies within reach of the path: its triangles are candidates
+      const auto take = [&](uint32_t j) {
+        if (seenCloth[j] == static_cast<uint32_t>(q)) return;
+        seenCloth[j] = static_cast<uint32_t>(q);
+        const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
+        if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
+        for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
+          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
+          if (seen[tri] == static_cast<uint32_t>(q)) continue;
+          seen[tri] = static_cast<uint32_t>(q);
+          if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
+        }
+      };
       // the path in pieces no longer than a cell; each piece's box of cells, row by row (one range each)
       const int pieces = std::max(1, static_cast<int>(std::ceil(std::sqrt(len2) / grid.cell)));
       for (int k = 0; k < pieces; ++k) {
@@ -223,26 +246,38 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
         if ((boxHi.array() < lo.array()).any() || (boxLo.array() > hi.array()).any()) continue;  // clear of the sheet
         const Eigen::Vector3i c0 = grid.clampedCell(boxLo), c1 = grid.clampedCell(boxHi);
         for (int cz = c0.z(); cz <= c1.z(); ++cz)
-          for (int cy = c0.y(); cy <= c1.y(); ++cy)
-            for (uint32_t e = grid.cellStart[grid.index(c0.x(), cy, cz)], e1 = grid.cellStart[grid.index(c1.x(), cy, cz) + 1];
-                 e < e1; ++e) {
-              const uint32_t j = grid.entry[e];
-              if (seenCloth[j] == static_cast<uint32_t>(q)) continue;
-              // distance from cloth particle j to the path
-              const Vec3 aj = Vec3(grid.px[e], grid.py[e], grid.pz[e]) - a;
-              const float u = len2 > 0.0f ? std::clamp(aj.dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
-              const float r = std::min(reachQ, grid.pr[e]);
-              if ((aj - u * ab).squaredNorm() >= r * r) continue;
-              seenCloth[j] = static_cast<uint32_t>(q);
-              const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
-              if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
-              for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
-                const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
-                if (seen[tri] == static_cast<uint32_t>(q)) continue;
-                seen[tri] = static_cast<uint32_t>(q);
-                if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
-              }
+          for (int cy = c0.y(); cy <= c1.y(); ++cy) {
+            const uint32_t e0 = grid.cellStart[grid.index(c0.x(), cy, cz)], e1 = grid.cellStart[grid.index(c1.x(), cy, cz) + 1];
+            uint32_t e = e0;
+#if defined(__AVX512F__)
+            // 16 slots of the row at a time; the few within reach are taken in slot order
+            const __m512 vax = _mm512_set1_ps(a.x()), vay = _mm512_set1_ps(a.y()), vaz = _mm512_set1_ps(a.z());
+            const __m512 vbx = _mm512_set1_ps(ab.x()), vby = _mm512_set1_ps(ab.y()), vbz = _mm512_set1_ps(ab.z());
+            const __m512 vinv = _mm512_set1_ps(invLen2), vreach = _mm512_set1_ps(reachQ);
+            const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+            for (; e < e1; e += 16) {
+              const __mmask16 lanes = e1 - e >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (e1 - e)) - 1u);
+              const __m512 jx = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.px.data() + e), vax);
+              const __m512 jy = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.py.data() + e), vay);
+              const __m512 jz = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.pz.data() + e), vaz);
+              const __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(jx, vbx), _mm512_mul_ps(jy, vby)), _mm512_mul_ps(jz, vbz));
+              const __m512 u = minPs(maxPs(_mm512_mul_ps(dot, vinv), zero), one);
+              const __m512 dx = _mm512_sub_ps(jx, _mm512_mul_ps(u, vbx)), dy = _mm512_sub_ps(jy, _mm512_mul_ps(u, vby)),
+                           dz = _mm512_sub_ps(jz, _mm512_mul_ps(u, vbz));
+              const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+              const __m512 r = minPs(vreach, _mm512_maskz_loadu_ps(lanes, grid.pr.data() + e));
+              for (uint32_t in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(r, r), _CMP_LT_OQ); in; in &= in - 1)
+                take(grid.entry[e + static_cast<uint32_t>(__builtin_ctz(in))]);
             }
+#endif
+            for (; e < e1; ++e) {  // the same arithmetic, one slot at a time
+              const float jx = grid.px[e] - a.x(), jy = grid.py[e] - a.y(), jz = grid.pz[e] - a.z();
+              const float u = std::min(std::max((jx * ab.x() + jy * ab.y() + jz * ab.z()) * invLen2, 0.0f), 1.0f);
+              const float dx = jx - u * ab.x(), dy = jy - u * ab.y(), dz = jz - u * ab.z();
+              const float r = std::min(reachQ, grid.pr[e]);
+              if (dx * dx + dy * dy + dz * dz < r * r) take(grid.entry[e]);
+            }
+          }
       }
       s.nearestCloth[static_cast<size_t>(w)] = nearest;
       s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
