@@ -132,6 +132,74 @@ void buildClothBoxGrid(const Particles& p, const std::vector<float>& reach, int6
   g.cellStart[0] = 0;
 }
 
+// the side of the sheet a water particle starting at xq0 is on: against the smoothed sheet normal at
+// its nearest cloth particle (+1 without one)
+float sheetSideOf(const Particles& p, const CouplingScratch& s, int32_t nearest, const Vec3& xq0) {
+  return nearest < 0 || (xq0 - p.x[nearest]).dot(s.sheetNormal[nearest]) >= 0.0f ? 1.0f : -1.0f;
+}
+
+// Eq. 21's sign for triangle tri: its own start plane where q starts over its face, else the sheet's side
+float candidateSideOf(const Model& model, const Particles& p, const CouplingScratch& s, uint32_t tri, const Vec3& xq0,
+                      float sheetSide) {
+  const auto& f = model.triangles[tri];
+  const Vec3& n0 = s.startNormal[tri];
+  const float dist = (xq0 - p.x[f[0]]).dot(n0);
+  const float own = dist >= 0.0f ? 1.0f : -1.0f;
+  if (own == sheetSide) return own;  // most candidates: both rules agree, no need to know where q projects
+  const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
+  return over.minCoeff() >= -kFaceTolerance ? own : sheetSide;
+}
+
+// calls take(j) for every cloth particle j of the grid within min(reachQ, its own reach) of the path
+// a -> a + ab (each may come more than once); reach: the largest such distance
+template <class Take>
+void walkNearPath(const ClothBoxGrid& grid, const Vec3& a, const Vec3& ab, float reachQ, float reach, Take&& take) {
+  const Vec3 lo = grid.origin, hi = grid.origin + grid.dims.cast<float>() * grid.cell;
+  const float len2 = ab.squaredNorm();
+  const float invLen2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;  // a still particle: its start point
+  // the path in pieces no longer than a cell; each piece's box of cells, row by row (one range each)
+  const int pieces = std::max(1, static_cast<int>(std::ceil(std::sqrt(len2) / grid.cell)));
+  for (int k = 0; k < pieces; ++k) {
+    const Vec3 p0 = a + ab * (static_cast<float>(k) / pieces), p1 = a + ab * (static_cast<float>(k + 1) / pieces);
+    const Vec3 boxLo = p0.cwiseMin(p1).array() - reach, boxHi = p0.cwiseMax(p1).array() + reach;
+    if ((boxHi.array() < lo.array()).any() || (boxLo.array() > hi.array()).any()) continue;  // clear of the sheet
+    const Eigen::Vector3i c0 = grid.clampedCell(boxLo), c1 = grid.clampedCell(boxHi);
+    for (int cz = c0.z(); cz <= c1.z(); ++cz)
+      for (int cy = c0.y(); cy <= c1.y(); ++cy) {
+        const uint32_t e0 = grid.cellStart[grid.index(c0.x(), cy, cz)], e1 = grid.cellStart[grid.index(c1.x(), cy, cz) + 1];
+        uint32_t e = e0;
+#if defined(__AVX512F__)
+        // 16 slots of the row at a time; the few within reach are taken in slot order
+        const __m512 vax = _mm512_set1_ps(a.x()), vay = _mm512_set1_ps(a.y()), vaz = _mm512_set1_ps(a.z());
+        const __m512 vbx = _mm512_set1_ps(ab.x()), vby = _mm512_set1_ps(ab.y()), vbz = _mm512_set1_ps(ab.z());
+        const __m512 vinv = _mm512_set1_ps(invLen2), vreach = _mm512_set1_ps(reachQ);
+        const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+        for (; e < e1; e += 16) {
+          const __mmask16 lanes = e1 - e >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (e1 - e)) - 1u);
+          const __m512 jx = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.px.data() + e), vax);
+          const __m512 jy = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.py.data() + e), vay);
+          const __m512 jz = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.pz.data() + e), vaz);
+          const __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(jx, vbx), _mm512_mul_ps(jy, vby)), _mm512_mul_ps(jz, vbz));
+          const __m512 u = minPs(maxPs(_mm512_mul_ps(dot, vinv), zero), one);
+          const __m512 dx = _mm512_sub_ps(jx, _mm512_mul_ps(u, vbx)), dy = _mm512_sub_ps(jy, _mm512_mul_ps(u, vby)),
+                       dz = _mm512_sub_ps(jz, _mm512_mul_ps(u, vbz));
+          const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+          const __m512 r = minPs(vreach, _mm512_maskz_loadu_ps(lanes, grid.pr.data() + e));
+          for (uint32_t in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(r, r), _CMP_LT_OQ); in; in &= in - 1)
+            take(grid.entry[e + static_cast<uint32_t>(__builtin_ctz(in))]);
+        }
+#endif
+        for (; e < e1; ++e) {  // the same arithmetic, one slot at a time
+          const float jx = grid.px[e] - a.x(), jy = grid.py[e] - a.y(), jz = grid.pz[e] - a.z();
+          const float u = std::min(std::max((jx * ab.x() + jy * ab.y() + jz * ab.z()) * invLen2, 0.0f), 1.0f);
+          const float dx = jx - u * ab.x(), dy = jy - u * ab.y(), dz = jz - u * ab.z();
+          const float r = std::min(reachQ, grid.pr[e]);
+          if (dx * dx + dy * dy + dz * dz < r * r) take(grid.entry[e]);
+        }
+      }
+  }
+}
+
 }  // namespace
 
 float couplingConstraint(const Vec3& xq, const Vec3& xa, const Vec3& xb, const Vec3& xc, float side, float thickness,
@@ -198,7 +266,6 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   // the cloth alone at its predicted positions (the solvers have moved it since the neighbour search)
   buildClothBoxGrid(p, s.vertexReach, nc, std::max(reachMax, 1e-4f), s.clothGrid);
   const ClothBoxGrid& grid = s.clothGrid;
-  const Vec3 lo = grid.origin, hi = grid.origin + grid.dims.cast<float>() * grid.cell;
   s.nearestCloth.resize(static_cast<size_t>(nw));
   const int nThreads = omp_get_max_threads();
   s.seen.resize(static_cast<size_t>(nThreads));
@@ -221,10 +288,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
       const int64_t q = nc + w;
       const Vec3 a = p.x[q], ab = p.xPred[q] - a;
       const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
-      const float len2 = ab.squaredNorm();
       float nearest2 = std::numeric_limits<float>::max();
       int32_t nearest = -1;
-      const float invLen2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;  // a still particle: its start point
       // cloth particle j lies within reach of the path: its triangles are candidates
       const auto take = [&](uint32_t j) {
         if (seenCloth[j] == static_cast<uint32_t>(q)) return;
@@ -238,47 +303,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
           if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
         }
       };
-      // the path in pieces no longer than a cell; each piece's box of cells, row by row (one range each)
-      const int pieces = std::max(1, static_cast<int>(std::ceil(std::sqrt(len2) / grid.cell)));
-      for (int k = 0; k < pieces; ++k) {
-        const Vec3 p0 = a + ab * (static_cast<float>(k) / pieces), p1 = a + ab * (static_cast<float>(k + 1) / pieces);
-        const Vec3 boxLo = p0.cwiseMin(p1).array() - reach, boxHi = p0.cwiseMax(p1).array() + reach;
-        if ((boxHi.array() < lo.array()).any() || (boxLo.array() > hi.array()).any()) continue;  // clear of the sheet
-        const Eigen::Vector3i c0 = grid.clampedCell(boxLo), c1 = grid.clampedCell(boxHi);
-        for (int cz = c0.z(); cz <= c1.z(); ++cz)
-          for (int cy = c0.y(); cy <= c1.y(); ++cy) {
-            const uint32_t e0 = grid.cellStart[grid.index(c0.x(), cy, cz)], e1 = grid.cellStart[grid.index(c1.x(), cy, cz) + 1];
-            uint32_t e = e0;
-#if defined(__AVX512F__)
-            // 16 slots of the row at a time; the few within reach are taken in slot order
-            const __m512 vax = _mm512_set1_ps(a.x()), vay = _mm512_set1_ps(a.y()), vaz = _mm512_set1_ps(a.z());
-            const __m512 vbx = _mm512_set1_ps(ab.x()), vby = _mm512_set1_ps(ab.y()), vbz = _mm512_set1_ps(ab.z());
-            const __m512 vinv = _mm512_set1_ps(invLen2), vreach = _mm512_set1_ps(reachQ);
-            const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
-            for (; e < e1; e += 16) {
-              const __mmask16 lanes = e1 - e >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (e1 - e)) - 1u);
-              const __m512 jx = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.px.data() + e), vax);
-              const __m512 jy = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.py.data() + e), vay);
-              const __m512 jz = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.pz.data() + e), vaz);
-              const __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(jx, vbx), _mm512_mul_ps(jy, vby)), _mm512_mul_ps(jz, vbz));
-              const __m512 u = minPs(maxPs(_mm512_mul_ps(dot, vinv), zero), one);
-              const __m512 dx = _mm512_sub_ps(jx, _mm512_mul_ps(u, vbx)), dy = _mm512_sub_ps(jy, _mm512_mul_ps(u, vby)),
-                           dz = _mm512_sub_ps(jz, _mm512_mul_ps(u, vbz));
-              const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
-              const __m512 r = minPs(vreach, _mm512_maskz_loadu_ps(lanes, grid.pr.data() + e));
-              for (uint32_t in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(r, r), _CMP_LT_OQ); in; in &= in - 1)
-                take(grid.entry[e + static_cast<uint32_t>(__builtin_ctz(in))]);
-            }
-#endif
-            for (; e < e1; ++e) {  // the same arithmetic, one slot at a time
-              const float jx = grid.px[e] - a.x(), jy = grid.py[e] - a.y(), jz = grid.pz[e] - a.z();
-              const float u = std::min(std::max((jx * ab.x() + jy * ab.y() + jz * ab.z()) * invLen2, 0.0f), 1.0f);
-              const float dx = jx - u * ab.x(), dy = jy - u * ab.y(), dz = jz - u * ab.z();
-              const float r = std::min(reachQ, grid.pr[e]);
-              if (dx * dx + dy * dy + dz * dz < r * r) take(grid.entry[e]);
-            }
-          }
-      }
+      walkNearPath(grid, a, ab, reachQ, reach, take);
       s.nearestCloth[static_cast<size_t>(w)] = nearest;
       s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
     }
@@ -304,21 +329,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   parallelFor(nw, [&](int64_t w) {
     const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
     const uint32_t c0 = s.candidateStart[static_cast<size_t>(w)], c1 = s.candidateStart[static_cast<size_t>(w) + 1];
-    const int32_t nearest = s.nearestCloth[static_cast<size_t>(w)];
-    const float sheetSide = nearest < 0 || (xq0 - p.x[nearest]).dot(s.sheetNormal[nearest]) >= 0.0f ? 1.0f : -1.0f;
-    for (uint32_t c = c0; c < c1; ++c) {
-      const uint32_t tri = s.candidates[c];
-      const auto& f = model.triangles[tri];
-      const Vec3& n0 = s.startNormal[tri];
-      const float dist = (xq0 - p.x[f[0]]).dot(n0);
-      const float own = dist >= 0.0f ? 1.0f : -1.0f;
-      if (own == sheetSide) {  // most candidates: both rules agree, no need to know where q projects
-        s.candidateSide[c] = own;
-        continue;
-      }
-      const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
-      s.candidateSide[c] = over.minCoeff() >= -kFaceTolerance ? own : sheetSide;
-    }
+    const float sheetSide = sheetSideOf(p, s, s.nearestCloth[static_cast<size_t>(w)], xq0);
+    for (uint32_t c = c0; c < c1; ++c) s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, sheetSide);
   });
 }
 
@@ -332,14 +344,17 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
   // triangle normals once per pass, shared by every water particle that tests the triangle
-  s.normal.resize(nTri);
+  s.plane.resize(nTri);
+  s.triangleThickness.resize(nTri);
   s.centroid.resize(nTri);
   s.reach.resize(nTri);
   parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
     const auto& f = model.triangles[t];
     const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
     const float l1 = n1.norm();
-    s.normal[t] = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
+    const Vec3 unit = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
+    s.plane[t] = {unit, p.xPred[f[0]]};
+    s.triangleThickness[t] = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
     const Vec3 c = (p.xPred[f[0]] + p.xPred[f[1]] + p.xPred[f[2]]) / 3.0f;
     s.centroid[t] = c;
     s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
@@ -361,70 +376,71 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       const float wq = p.invMass[q];
       const Vec3 xq0 = p.x[q];
       Vec3 dq = Vec3::Zero();
+      // Eq. 21 for one candidate; true when it moved q
+      const auto visit = [&](uint32_t tri, float side, int sweep) {
+        const TrianglePlane& plane = s.plane[tri];
+        const Vec3& n1 = plane.normal;
+        if (n1.isZero()) return false;
+        if (rigidCloth && s.triangleStiffness[tri] < 1.0f) return false;  // Eq. 22: wet cloth lets water through
+        const float thickness = s.triangleThickness[tri];
+        const Vec3 xq = p.xPred[q] + dq;
+        // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
+        // triangles end here, before the closest point is needed
+        const float dist = side * (xq - plane.origin).dot(n1);
+        // a later sweep only needs q back on its side: a fold narrower than 2d cannot hold it d from both
+        const float C = dist - (sweep == 0 ? thickness : 0.25f * thickness);
+        if (C >= 0.0f) return false;
+        const auto& f = model.triangles[tri];
+        Vec3 bary;
+        bool contact = false;
+        // a path through the face: q started on its side of the plane and is now behind it, and the
+        // point where its path met the plane lies on the triangle. Found wherever q ended up, so a
+        // particle faster than h per step cannot pass the sheet (a departure from the closest-point
+        // test alone, docs/models.md on Eq. 21)
+        if (dist < 0.0f) {
+          const float before = side * (xq0 - plane.origin).dot(n1);
+          if (before > 0.0f) {
+            const Vec3 hit = xq0 + (before / (before - dist)) * (xq - xq0);
+            bary = planeBarycentric(hit, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]]);
+            contact = bary.minCoeff() >= -kFaceTolerance;
+            if (contact) bary = bary.cwiseMax(0.0f) / bary.cwiseMax(0.0f).sum();
+          }
+        }
+        if (!contact) {
+          if (sweep > 0) return false;
+          // Eq. 21 near the face: the closest point must lie within d/2 of q's projection on the plane
+          // (below), and every point of the triangle is within reach of its centroid: a cheap test
+          // that rejects no contact
+          const Vec3 toC = xq - s.centroid[tri];
+          const float lateral = s.reach[tri] + 0.5f * thickness;
+          if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) return false;
+          Vec3 nrm;
+          couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
+          // only a contact over the triangle's face counts; far below or beside it is another
+          // triangle's business
+          const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
+          const Vec3 off = xq - pt;
+          const float along = std::fabs(off.dot(n1));
+          if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) return false;
+          if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) return false;
+        }
+        const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
+                    wc = rigidCloth ? 0.0f : p.invMass[f[2]];
+        const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
+        if (denom <= 0.0f) return false;
+        // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
+        const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
+        const float dl = -C / denom * kappa;
+        const Vec3 g = side * n1;
+        dq += wq * dl * g;
+        if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
+        return true;
+      };
       // the rigid pass sweeps the candidates again, for paths through a face only, while it still
       // moves q: in a crumpled sheet the correction of one triangle can push q through another
       for (int sweep = 0, sweeps = rigidCloth ? kRigidSweeps : 1; sweep < sweeps; ++sweep) {
         bool moved = false;
-        for (uint32_t c = c0; c < c1; ++c) {
-          const uint32_t tri = s.candidates[c];
-          const auto& f = model.triangles[tri];
-          const Vec3& n1 = s.normal[tri];
-          if (n1.isZero()) continue;
-          if (rigidCloth && s.triangleStiffness[tri] < 1.0f) continue;  // Eq. 22: wet cloth lets water through
-          const float side = s.candidateSide[c];
-          const float thickness = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
-          const Vec3 xq = p.xPred[q] + dq;
-          // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
-          // triangles end here, before the closest point is needed
-          const float dist = side * (xq - p.xPred[f[0]]).dot(n1);
-          // a later sweep only needs q back on its side: a fold narrower than 2d cannot hold it d from both
-          const float C = dist - (sweep == 0 ? thickness : 0.25f * thickness);
-          if (C >= 0.0f) continue;
-          Vec3 bary;
-          bool contact = false;
-          // a path through the face: q started on its side of the plane and is now behind it, and the
-          // point where its path met the plane lies on the triangle. Found wherever q ended up, so a
-          // particle faster than h per step cannot pass the sheet (a departure from the closest-point
-          // test alone, docs/models.md on Eq. 21)
-          if (dist < 0.0f) {
-            const float before = side * (xq0 - p.xPred[f[0]]).dot(n1);
-            if (before > 0.0f) {
-              const Vec3 hit = xq0 + (before / (before - dist)) * (xq - xq0);
-              bary = planeBarycentric(hit, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]]);
-              contact = bary.minCoeff() >= -kFaceTolerance;
-              if (contact) bary = bary.cwiseMax(0.0f) / bary.cwiseMax(0.0f).sum();
-            }
-          }
-          if (!contact) {
-            if (sweep > 0) continue;
-            // Eq. 21 near the face: the closest point must lie within d/2 of q's projection on the plane
-            // (below), and every point of the triangle is within reach of its centroid: a cheap test
-            // that rejects no contact
-            const Vec3 toC = xq - s.centroid[tri];
-            const float lateral = s.reach[tri] + 0.5f * thickness;
-            if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) continue;
-            Vec3 nrm;
-            couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
-            // only a contact over the triangle's face counts; far below or beside it is another
-            // triangle's business
-            const Vec3 pt = bary.x() * p.xPred[f[0]] + bary.y() * p.xPred[f[1]] + bary.z() * p.xPred[f[2]];
-            const Vec3 off = xq - pt;
-            const float along = std::fabs(off.dot(n1));
-            if ((off - off.dot(n1) * n1).squaredNorm() > 0.25f * thickness * thickness) continue;
-            if (along > p.radius[q] + (p.xPred[q] - xq0).norm()) continue;
-          }
-          const float wa = rigidCloth ? 0.0f : p.invMass[f[0]], wb = rigidCloth ? 0.0f : p.invMass[f[1]],
-                      wc = rigidCloth ? 0.0f : p.invMass[f[2]];
-          const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
-          if (denom <= 0.0f) continue;
-          // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
-          const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
-          const float dl = -C / denom * kappa;
-          const Vec3 g = side * n1;
-          dq += wq * dl * g;
-          moved = true;
-          if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
-        }
+        for (uint32_t c = c0; c < c1; ++c) moved |= visit(s.candidates[c], s.candidateSide[c], sweep);
         if (!moved) break;
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q

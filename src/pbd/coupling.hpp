@@ -40,6 +40,12 @@ struct ClothBoxGrid {
   }
 };
 
+// a triangle's plane: its unit normal (0: degenerate) and first corner
+struct TrianglePlane {
+  Vec3 normal;
+  Vec3 origin;  // m
+};
+
 struct CouplingScratch {
   std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
@@ -54,7 +60,8 @@ struct CouplingScratch {
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep (0: degenerate)
   std::vector<Vec3> vertexNormal;            // per cloth particle: its triangles' area-weighted normals, summed
   std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
-  std::vector<Vec3> normal;                  // unit normal of each triangle at the predicted positions
+  std::vector<TrianglePlane> plane;          // each triangle's plane at the predicted positions
+  std::vector<float> triangleThickness;      // m, d of each triangle's piece
   std::vector<Vec3> centroid;                // m, of each triangle at the predicted positions
   std::vector<float> reach;                  // m, the farthest vertex from the centroid
   std::vector<Vec3> clothDelta;
