@@ -88,11 +88,25 @@ struct ClothPiece {
 };
 
 // Eq. 8 constraints as a struct of arrays; solved colour by colour (no two share a particle)
+// the order the cloth solver projects a set of constraints in (src/pbd/cloth.cpp). The cloth
+// particles are cut into numSlabs slabs of equal count along the rest shape's longest axis; the
+// constraints are grouped (group g < numSlabs: inside slab g; numSlabs + k: across slabs k and k + 1;
+// 2 numSlabs - 1: the rest) and stored group by group, colour by colour. A block (the constraints of
+// one colour in one group) shares no particle, nor do the groups of one phase (the slabs; the even
+// interfaces; the odd ones): a phase's groups run in parallel and the result does not depend on how
+// they are spread over threads.
+struct ConstraintSchedule {
+  int numSlabs = 0;
+  int numColors = 0;               // colours of the greedy colouring the blocks come from
+  std::vector<int> groupBlock;     // blocks of group g: [groupBlock[g], groupBlock[g + 1])
+  std::vector<int> blockStart;     // constraints of block b: [blockStart[b], blockStart[b + 1])
+};
+
 struct StretchConstraints {
   std::vector<std::array<int, 2>> ids;
   std::vector<float> restLength;   // m
   std::vector<float> compliance;   // m/N (XPBD alpha)
-  std::vector<int> colorStart;     // constraints of colour c are [colorStart[c], colorStart[c+1])
+  ConstraintSchedule schedule;
 };
 
 // Eq. 9 constraints: ids = {shared edge a, shared edge b, wing c, wing d}
@@ -100,7 +114,7 @@ struct BendConstraints {
   std::vector<std::array<int, 4>> ids;
   std::vector<float> restAngle;    // rad, signed dihedral angle at rest
   std::vector<float> compliance;   // 1/(N m)
-  std::vector<int> colorStart;
+  ConstraintSchedule schedule;
 };
 
 // long range attachments (Kim, Chentanez, Müller 2012): a free cloth particle may be at most

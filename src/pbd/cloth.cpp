@@ -183,7 +183,8 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   const BendConstraints& bd = model.bend;
   scratch.stretchLambda.assign(st.ids.size(), 0.0f);
   scratch.bendLambda.assign(bd.ids.size(), 0.0f);
-  scratch.correction.resize(12 * std::max(st.ids.size(), bd.ids.size()));
+  scratch.correction.resize(6 * st.ids.size());
+  scratch.correctionBend.resize(12 * bd.ids.size());
   scratch.bendC.resize(bd.ids.size());
   if (model.numCloth == 0 || dt <= 0.0f) return;
   const float invDt2 = 1.0f / (dt * dt);
@@ -192,41 +193,55 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   float* stretchLambda = scratch.stretchLambda.data();
   float* bendLambda = scratch.bendLambda.data();
 
-  // one parallel region for every colour of every iteration: a barrier between colours (the implicit
-  // one of each omp for) instead of a fork and join; colours below the grain run on one thread
-  const size_t stride = std::max(st.ids.size(), bd.ids.size());
-  float* corr = scratch.correction.data();
-  const auto stretchColour = [&](int begin, int end) {
+  // separate buffers for the two kinds: a thread may project stretch constraints while another
+  // projects bend constraints of the same indices
+  float* corrStretch = scratch.correction.data();
+  float* corrBend = scratch.correctionBend.data();
+  const size_t strideStretch = st.ids.size(), strideBend = bd.ids.size();
+  const auto stretchBlock = [&](int begin, int end) {
     stretchRange(begin, end, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
-                 stretchLambda, corr, stride);
+                 stretchLambda, corrStretch, strideStretch);
     for (int k = begin; k < end; ++k)
       for (int v = 0; v < 2; ++v)
-        x[st.ids[k][v]] += Vec3(corr[(3 * v) * stride + k], corr[(3 * v + 1) * stride + k], corr[(3 * v + 2) * stride + k]);
+        x[st.ids[k][v]] += Vec3(corrStretch[(3 * v) * strideStretch + k], corrStretch[(3 * v + 1) * strideStretch + k],
+                                corrStretch[(3 * v + 2) * strideStretch + k]);
   };
-  const auto bendColour = [&](int begin, int end) {
+  const auto bendBlock = [&](int begin, int end) {
     bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
-              bendLambda, corr, scratch.bendC.data(), stride);
+              bendLambda, corrBend, scratch.bendC.data(), strideBend);
     for (int k = begin; k < end; ++k)
       for (int v = 0; v < 4; ++v)
-        x[bd.ids[k][v]] += Vec3(corr[(3 * v) * stride + k], corr[(3 * v + 1) * stride + k], corr[(3 * v + 2) * stride + k]);
+        x[bd.ids[k][v]] += Vec3(corrBend[(3 * v) * strideBend + k], corrBend[(3 * v + 1) * strideBend + k],
+                                corrBend[(3 * v + 2) * strideBend + k]);
   };
-  // each colour split in contiguous chunks, one per thread; a chunk's constraints share no particle
-  // with another's, so the split does not change the result
-  const auto solveColour = [&](const auto& colour, int begin, int end) {
-    if (end - begin < kParallelGrain) {
-#pragma omp single
-      colour(begin, end);
-    } else {
-      const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-      const int64_t len = end - begin;
-      colour(begin + static_cast<int>(len * t / nt), begin + static_cast<int>(len * (t + 1) / nt));
-#pragma omp barrier
-    }
+  // one group: its stretch constraints colour by colour, then its bend constraints
+  const ConstraintSchedule& ss = st.schedule;
+  const ConstraintSchedule& bs = bd.schedule;
+  const auto solveGroup = [&](int g) {
+    if (static_cast<size_t>(g) + 1 < ss.groupBlock.size())
+      for (int b = ss.groupBlock[g]; b < ss.groupBlock[g + 1]; ++b) stretchBlock(ss.blockStart[b], ss.blockStart[b + 1]);
+    if (static_cast<size_t>(g) + 1 < bs.groupBlock.size())
+      for (int b = bs.groupBlock[g]; b < bs.groupBlock[g + 1]; ++b) bendBlock(bs.blockStart[b], bs.blockStart[b + 1]);
   };
+  // Gauss-Seidel in a fixed order of phases: every slab (in parallel, a slab's groups whole on one
+  // thread), the interfaces between slabs k and k + 1 for even k, then for odd k, then the rest on
+  // one thread. Four barriers per iteration instead of one per colour, and the groups of a phase
+  // share no particle, so the result does not depend on the thread count (ConstraintSchedule)
+  const int slabs = std::max(ss.numSlabs, 1);
+  const int interfaces[2] = {slabs / 2, (slabs - 1) / 2};  // k = 0, 2, 4 ... < slabs - 1, then 1, 3 ...
 #pragma omp parallel
-  for (int it = 0; it < iterations; ++it) {
-    for (size_t c = 0; c + 1 < st.colorStart.size(); ++c) solveColour(stretchColour, st.colorStart[c], st.colorStart[c + 1]);
-    for (size_t c = 0; c + 1 < bd.colorStart.size(); ++c) solveColour(bendColour, bd.colorStart[c], bd.colorStart[c + 1]);
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    for (int it = 0; it < iterations; ++it) {
+      for (int g = slabs * t / nt; g < slabs * (t + 1) / nt; ++g) solveGroup(g);
+#pragma omp barrier
+      for (int parity = 0; parity < 2; ++parity) {
+        for (int m = interfaces[parity] * t / nt; m < interfaces[parity] * (t + 1) / nt; ++m) solveGroup(slabs + 2 * m + parity);
+#pragma omp barrier
+      }
+#pragma omp single
+      solveGroup(2 * slabs - 1);
+    }
   }
 }
 

@@ -119,7 +119,6 @@ std::vector<int> greedyColors(const std::vector<std::array<int, N>>& ids, int nu
   return color;
 }
 
-// stable reorder by colour so colour c is [colorStart[c], colorStart[c + 1])
 template <class T>
 void permute(std::vector<T>& a, const std::vector<int>& order) {
   std::vector<T> out(a.size());
@@ -127,13 +126,52 @@ void permute(std::vector<T>& a, const std::vector<int>& order) {
   a.swap(out);
 }
 
-std::vector<int> colorOrder(const std::vector<int>& color, int numColors, std::vector<int>& colorStart) {
-  std::vector<int> order(color.size());
+// the slab of each cloth particle: numSlabs runs of equal count along the rest shape's longest axis
+std::vector<int> restSlabs(const std::vector<Vec3>& rest, int numSlabs) {
+  const int n = static_cast<int>(rest.size());
+  std::vector<int> slab(rest.size(), 0);
+  if (n == 0) return slab;
+  Vec3 lo = rest[0], hi = rest[0];
+  for (const Vec3& x : rest) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  std::vector<int> order(rest.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return color[x] < color[y]; });
-  colorStart.assign(numColors + 1, 0);
-  for (int c : color) ++colorStart[c + 1];
-  for (int c = 0; c < numColors; ++c) colorStart[c + 1] += colorStart[c];
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return rest[a][axis] < rest[b][axis]; });
+  for (int k = 0; k < n; ++k) slab[order[k]] = static_cast<int>(static_cast<int64_t>(k) * numSlabs / n);
+  return slab;
+}
+
+// stable reorder by (group, colour) and the blocks of the schedule (ConstraintSchedule in model.hpp)
+template <size_t N>
+std::vector<int> scheduleOrder(const std::vector<std::array<int, N>>& ids, const std::vector<int>& color, int numColors,
+                               const std::vector<int>& slab, int numSlabs, ConstraintSchedule& schedule) {
+  const int groups = 2 * numSlabs;
+  std::vector<int> group(ids.size());
+  for (size_t k = 0; k < ids.size(); ++k) {
+    int lo = numSlabs, hi = -1;
+    for (int v : ids[k]) lo = std::min(lo, slab[v]), hi = std::max(hi, slab[v]);
+    group[k] = lo == hi ? lo : (hi == lo + 1 ? numSlabs + lo : groups - 1);
+  }
+  std::vector<int> order(ids.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int x, int y) { return std::pair(group[x], color[x]) < std::pair(group[y], color[y]); });
+  schedule.numSlabs = numSlabs;
+  schedule.numColors = numColors;
+  schedule.blockStart.clear();
+  std::vector<int> blockGroup;
+  for (size_t k = 0; k < order.size(); ++k) {
+    const int g = group[order[k]], c = color[order[k]];
+    if (k > 0 && g == group[order[k - 1]] && c == color[order[k - 1]]) continue;
+    schedule.blockStart.push_back(static_cast<int>(k));
+    blockGroup.push_back(g);
+  }
+  schedule.blockStart.push_back(static_cast<int>(order.size()));
+  // blocks come group by group: group g's are [groupBlock[g], groupBlock[g + 1])
+  schedule.groupBlock.assign(static_cast<size_t>(groups) + 1, 0);
+  for (int g : blockGroup) ++schedule.groupBlock[static_cast<size_t>(g) + 1];
+  for (int g = 0; g < groups; ++g) schedule.groupBlock[static_cast<size_t>(g) + 1] += schedule.groupBlock[static_cast<size_t>(g)];
   return order;
 }
 
@@ -206,15 +244,18 @@ void rebuildTopology(Model& model) {
     model.vertexNeighborStart[v + 1] = static_cast<int>(model.vertexNeighbors.size());
   }
 
+  // slabs of about 1500 particles, at most 8 (the solver's parallel phases, src/pbd/cloth.cpp)
+  const int numSlabs = std::clamp(n / 1500, 1, 8);
+  const std::vector<int> slab = restSlabs(model.clothRestPosition, numSlabs);
   int numColors = 0;
   std::vector<int> color = greedyColors(stretch.ids, n, numColors);
-  std::vector<int> order = colorOrder(color, numColors, stretch.colorStart);
+  std::vector<int> order = scheduleOrder(stretch.ids, color, numColors, slab, numSlabs, stretch.schedule);
   permute(stretch.ids, order);
   permute(stretch.restLength, order);
   permute(stretch.compliance, order);
 
   color = greedyColors(bend.ids, n, numColors);
-  order = colorOrder(color, numColors, bend.colorStart);
+  order = scheduleOrder(bend.ids, color, numColors, slab, numSlabs, bend.schedule);
   permute(bend.ids, order);
   permute(bend.restAngle, order);
   permute(bend.compliance, order);
