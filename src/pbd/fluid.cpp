@@ -134,8 +134,8 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   // are constants of the loops, the same numbers as 0.5 (h_i + h_j) and its reciprocal
   const auto [hMin, hMax] = std::minmax_element(p.radius.begin(), p.radius.end());
   const float hU = *hMax, invU = 1.0f / hU;
-  const auto solve = [&](auto uniform) {
-    constexpr bool U = decltype(uniform)::value;
+  const auto solve = [&](auto uniform, auto tensile) {
+    constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (int it = 0; it < iterations; ++it) {
       // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
       parallelFor(nw, [&](int64_t w) {
@@ -187,7 +187,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
           const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
           const float r2 = rx * rx + ry * ry + rz * rz;
           const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
-          const float sc = phase[j] == kWaterPhase ? sCorrK * tensileCorrection(1.0f, oneMinusDq2, tensileN, r2, kh * kh) : 0.0f;
+          const float sc = Tensile && phase[j] == kWaterPhase ? sCorrK * tensileCorrection(1.0f, oneMinusDq2, tensileN, r2, kh * kh) : 0.0f;
           const float f = M[j] * (li + L[j] + sc) * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
           dx += f * rx;
           dy += f * ry;
@@ -205,14 +205,14 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
 
         for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1]; ++k) {
           const uint32_t i = index[k];
-          const bool push = phase[i] == kWaterPhase && L[i] != 0.0f;
+          if (phase[i] != kWaterPhase || L[i] == 0.0f) continue;  // only compressed water pushes
           const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
           const float kh = U ? hU : 0.5f * (H[i] + hb), kinv = U ? invU : 1.0f / kh;
-          const float f = push ? p.mass[i] * L[i] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz) : 0.0f;
+          const float f = p.mass[i] * L[i] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz);
           dx -= f * rx;
           dy -= f * ry;
           dz -= f * rz;
-          pushing += push ? 1 : 0;
+          ++pushing;
         }
         // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
         // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
@@ -223,10 +223,11 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       });
     }
   };
-  if (*hMin == *hMax)
-    solve(std::true_type{});
-  else
-    solve(std::false_type{});
+  const bool uniform = *hMin == *hMax, tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
+  if (uniform && tensile) solve(std::true_type{}, std::true_type{});
+  if (uniform && !tensile) solve(std::true_type{}, std::false_type{});
+  if (!uniform && tensile) solve(std::false_type{}, std::true_type{});
+  if (!uniform && !tensile) solve(std::false_type{}, std::false_type{});
 }
 
 void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt) {
