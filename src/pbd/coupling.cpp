@@ -345,7 +345,6 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   const int iters = std::max(1, model.solver.couplingIterations);
   // triangle normals once per pass, shared by every water particle that tests the triangle
   s.plane.resize(nTri);
-  s.triangleThickness.resize(nTri);
   s.centroid.resize(nTri);
   s.reach.resize(nTri);
   parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
@@ -353,8 +352,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
     const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
     const float l1 = n1.norm();
     const Vec3 unit = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
-    s.plane[t] = {unit, p.xPred[f[0]]};
-    s.triangleThickness[t] = model.pieces[clothPiece(p.phase[f[0]])].material.thickness;
+    s.plane[t] = {unit, model.pieces[clothPiece(p.phase[f[0]])].material.thickness, p.xPred[f[0]], s.triangleStiffness[t]};
     const Vec3 c = (p.xPred[f[0]] + p.xPred[f[1]] + p.xPred[f[2]]) / 3.0f;
     s.centroid[t] = c;
     s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
@@ -381,8 +379,8 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const TrianglePlane& plane = s.plane[tri];
         const Vec3& n1 = plane.normal;
         if (n1.isZero()) return false;
-        if (rigidCloth && s.triangleStiffness[tri] < 1.0f) return false;  // Eq. 22: wet cloth lets water through
-        const float thickness = s.triangleThickness[tri];
+        if (rigidCloth && plane.stiffness < 1.0f) return false;  // Eq. 22: wet cloth lets water through
+        const float thickness = plane.thickness;
         const Vec3 xq = p.xPred[q] + dq;
         // C = s (x_q - p) . n - d, and (x_q - p) . n is the distance to the plane: most
         // triangles end here, before the closest point is needed
@@ -429,7 +427,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const float denom = wq + wa * bary.x() * bary.x() + wb * bary.y() * bary.y() + wc * bary.z() * bary.z();
         if (denom <= 0.0f) return false;
         // kappa^couple through Eq. 5 (1 when dry); the rigid final pass always enforces fully
-        const float kappa = rigidCloth ? 1.0f : iterationFactor(s.triangleStiffness[tri], iters);
+        const float kappa = rigidCloth ? 1.0f : iterationFactor(plane.stiffness, iters);
         const float dl = -C / denom * kappa;
         const Vec3 g = side * n1;
         dq += wq * dl * g;

@@ -40,10 +40,13 @@ struct ClothBoxGrid {
   }
 };
 
-// a triangle's plane: its unit normal (0: degenerate) and first corner
+// what a coupling pass reads of a triangle, in one 32-byte record: its unit normal (0: degenerate)
+// and first corner at the predicted positions, its piece's thickness d and its kappa^couple
 struct TrianglePlane {
   Vec3 normal;
-  Vec3 origin;  // m
+  float thickness;   // m
+  Vec3 origin;       // m
+  float stiffness;   // kappa^couple (Eq. 22)
 };
 
 struct CouplingScratch {
@@ -61,7 +64,6 @@ struct CouplingScratch {
   std::vector<Vec3> vertexNormal;            // per cloth particle: its triangles' area-weighted normals, summed
   std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
   std::vector<TrianglePlane> plane;          // each triangle's plane at the predicted positions
-  std::vector<float> triangleThickness;      // m, d of each triangle's piece
   std::vector<Vec3> centroid;                // m, of each triangle at the predicted positions
   std::vector<float> reach;                  // m, the farthest vertex from the centroid
   std::vector<Vec3> clothDelta;
