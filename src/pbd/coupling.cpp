@@ -97,6 +97,7 @@ void buildClothBoxGrid(const Particles& p, const std::vector<float>& reach, int6
     hi = hi.cwiseMax(p.xPred[j]);
   }
   const double maxCells = 4.0 * static_cast<double>(nc) + 4096.0;
+  if (!lo.allFinite() || !hi.allFinite()) hi = lo = Vec3::Zero();  // a diverged cloth: one cell (the step reports it)
   for (;;) {
     const Vec3 span = (hi - lo) / cell;
     g.dims = {static_cast<int>(span.x()) + 1, static_cast<int>(span.y()) + 1, static_cast<int>(span.z()) + 1};

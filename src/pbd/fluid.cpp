@@ -82,6 +82,24 @@ float restGradientNorm(const WaterParams& w) {
   return sum + gi.squaredNorm() / m;
 }
 
+// calls f with two compile-time flags (std::true_type / std::false_type) for the run-time ones, so a
+// neighbour loop has no test of them per pair
+template <class F>
+void withFlags(bool a, bool b, F&& f) {
+  if (a && b) f(std::true_type{}, std::true_type{});
+  if (a && !b) f(std::true_type{}, std::false_type{});
+  if (!a && b) f(std::false_type{}, std::true_type{});
+  if (!a && !b) f(std::false_type{}, std::false_type{});
+}
+
+// true when every particle has the same support radius h (no partial absorption yet): then a pair's
+// h and 1 / h are loop constants, the same numbers as 0.5 (h_i + h_j) and its reciprocal
+bool commonRadius(const std::vector<float>& radius, float& h) {
+  const auto [lo, hi] = std::minmax_element(radius.begin(), radius.end());
+  h = hi == radius.end() ? 1.0f : *hi;
+  return lo == radius.end() || *lo == *hi;
+}
+
 }  // namespace
 
 // The neighbour loops are scalar: vectorised (omp simd), GCC 12 emulates the gathers of j's data
@@ -130,10 +148,9 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const int32_t* phase = p.phase.data();
   const uint32_t* index = nb.index.data();
 
-  // every particle with the same support radius (no partial absorption yet): the pair's h and 1 / h
-  // are constants of the loops, the same numbers as 0.5 (h_i + h_j) and its reciprocal
-  const auto [hMin, hMax] = std::minmax_element(p.radius.begin(), p.radius.end());
-  const float hU = *hMax, invU = 1.0f / hU;
+  float hU = 0.0f;
+  const bool uniform = commonRadius(p.radius, hU);
+  const float invU = 1.0f / hU;
   const auto solve = [&](auto uniform, auto tensile) {
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (int it = 0; it < iterations; ++it) {
@@ -223,11 +240,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       });
     }
   };
-  const bool uniform = *hMin == *hMax, tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
-  if (uniform && tensile) solve(std::true_type{}, std::true_type{});
-  if (uniform && !tensile) solve(std::true_type{}, std::false_type{});
-  if (!uniform && tensile) solve(std::false_type{}, std::true_type{});
-  if (!uniform && !tensile) solve(std::false_type{}, std::false_type{});
+  withFlags(uniform, sCorrK != 0.0f, solve);  // s_corr is 0 without artificial pressure
 }
 
 void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt) {
@@ -249,8 +262,9 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   // omega_i = sum_j V_j v_ij x grad W_ij (Macklin 2013 Eq. 15), only for the confinement, and XSPH
   // (Eq. 17) weighted by V_ij. Compile-time flags: every radius equal (h and 1 / h are constants, as
   // in solveFluid), vorticity wanted
-  const auto [hMin, hMax] = std::minmax_element(p.radius.begin(), p.radius.end());
-  const float hU = *hMax, invU = 1.0f / hU;
+  float hU = 0.0f;
+  const bool uniform = commonRadius(p.radius, hU);
+  const float invU = 1.0f / hU;
   const auto xsph = [&](auto uniform, auto vortex) {
     constexpr bool U = decltype(uniform)::value, Vort = decltype(vortex)::value;
     parallelFor(nw, [&](int64_t w) {
@@ -281,11 +295,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
       vNew[i] = Vec3(vxi, vyi, vzi) + wp.viscosity * Vec3(bx, by, bz);
     });
   };
-  const bool uniform = *hMin == *hMax, vortex = wp.vorticity > 0.0f;
-  if (uniform && vortex) xsph(std::true_type{}, std::true_type{});
-  if (uniform && !vortex) xsph(std::true_type{}, std::false_type{});
-  if (!uniform && vortex) xsph(std::false_type{}, std::true_type{});
-  if (!uniform && !vortex) xsph(std::false_type{}, std::false_type{});
+  withFlags(uniform, wp.vorticity > 0.0f, xsph);
   if (wp.vorticity > 0.0f) {
     // f = epsilon (N x omega), N = eta / |eta|, eta = grad |omega| (Macklin 2013 Eq. 16)
     s.vorticityNorm.resize(n);
