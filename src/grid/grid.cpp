@@ -197,50 +197,58 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
     lists.index.reserve(total + total / 8);
   }
 
-  // one distance pass, block by block: the threads split a block of particles in contiguous
-  // ranges, gather into their own buffers, then copy to the list in particle order. The lists do
-  // not depend on the thread count; the buffers hold one block, not a copy of the lists.
-  constexpr size_t kBlock = 8192;
+  // one distance pass in chunks of particles that the threads take as they come (a folded or bunched
+  // part of the sheet has many more neighbours than the rest, so equal halves were unequal work): each
+  // chunk gathers into its own buffer, then the buffers are copied to the list in particle order, so
+  // the lists do not depend on which thread did what. Rounds of kRound chunks: the buffers hold one
+  // round, not a copy of the lists.
+  constexpr size_t kChunk = 256, kRound = 64;
   uint32_t* start = lists.start.data();
   uint32_t* mid = lists.mid.data();
-  std::vector<size_t> offset(static_cast<size_t>(parallel ? omp_get_max_threads() : 1) + 1, 0);
+  lists.chunkBuffers.resize(kRound);
+  std::vector<size_t> offset(kRound + 1, 0);
+  for (size_t r0 = 0; r0 < n; r0 += kChunk * kRound) {
+    const int64_t chunks = static_cast<int64_t>(std::min(kRound, (n - r0 + kChunk - 1) / kChunk));
 #pragma omp parallel if (parallel)
-  {
-    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    RangeCache cache;
-    std::vector<uint32_t> cl(256), wa(256), out;
-    for (size_t b0 = 0; b0 < n; b0 += kBlock) {
-      const size_t b1 = std::min(n, b0 + kBlock);
-      const size_t lo = b0 + (b1 - b0) * static_cast<size_t>(t) / static_cast<size_t>(nt);
-      const size_t hi = b0 + (b1 - b0) * static_cast<size_t>(t + 1) / static_cast<size_t>(nt);
-      out.clear();
-      for (size_t i = lo; i < hi; ++i) {
-        uint32_t ncl, nwa;
-        gather(i, cache, cl, wa, ncl, nwa);
-        start[i + 1] = ncl + nwa;  // a count until the offsets are known
-        mid[i] = ncl;
-        out.insert(out.end(), cl.data(), cl.data() + ncl);
-        out.insert(out.end(), wa.data(), wa.data() + nwa);
+    {
+      RangeCache cache;
+      std::vector<uint32_t> cl(256), wa(256);
+#pragma omp for schedule(dynamic, 1)
+      for (int64_t c = 0; c < chunks; ++c) {
+        std::vector<uint32_t>& out = lists.chunkBuffers[static_cast<size_t>(c)];
+        out.clear();
+        const size_t lo = r0 + static_cast<size_t>(c) * kChunk, hi = std::min(n, lo + kChunk);
+        for (size_t i = lo; i < hi; ++i) {
+          uint32_t ncl, nwa;
+          gather(i, cache, cl, wa, ncl, nwa);
+          start[i + 1] = ncl + nwa;  // a count until the offsets are known
+          mid[i] = ncl;
+          out.insert(out.end(), cl.data(), cl.data() + ncl);
+          out.insert(out.end(), wa.data(), wa.data() + nwa);
+        }
       }
-      offset[static_cast<size_t>(t) + 1] = out.size();
-#pragma omp barrier
 #pragma omp single
       {
-        offset[0] = start[b0];
-        for (int u = 0; u < nt; ++u) offset[static_cast<size_t>(u) + 1] += offset[static_cast<size_t>(u)];
-        const size_t total = offset[static_cast<size_t>(nt)];
+        offset[0] = start[r0];
+        for (int64_t c = 0; c < chunks; ++c)
+          offset[static_cast<size_t>(c) + 1] = offset[static_cast<size_t>(c)] + lists.chunkBuffers[static_cast<size_t>(c)].size();
+        const size_t total = offset[static_cast<size_t>(chunks)];
         if (total > lists.index.capacity()) lists.index.reserve(total + total / 4);  // neighbours grew
         lists.index.resize(total);
       }
-      std::copy(out.begin(), out.end(), lists.index.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(t)]));
-      size_t s = offset[static_cast<size_t>(t)];
-      for (size_t i = lo; i < hi; ++i) {
-        const uint32_t c = start[i + 1];
-        mid[i] = static_cast<uint32_t>(s) + mid[i];
-        s += c;
-        start[i + 1] = static_cast<uint32_t>(s);
+#pragma omp for schedule(static)
+      for (int64_t c = 0; c < chunks; ++c) {
+        const std::vector<uint32_t>& out = lists.chunkBuffers[static_cast<size_t>(c)];
+        std::copy(out.begin(), out.end(), lists.index.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(c)]));
+        size_t sum = offset[static_cast<size_t>(c)];
+        const size_t lo = r0 + static_cast<size_t>(c) * kChunk, hi = std::min(n, lo + kChunk);
+        for (size_t i = lo; i < hi; ++i) {
+          const uint32_t count = start[i + 1];
+          mid[i] = static_cast<uint32_t>(sum) + mid[i];
+          sum += count;
+          start[i + 1] = static_cast<uint32_t>(sum);
+        }
       }
-#pragma omp barrier
     }
   }
 }
