@@ -25,6 +25,9 @@ inline void parallelForDynamic(int64_t n, int64_t chunk, F&& body) {
   for (int64_t i = 0; i < n; ++i) body(i);
 }
 
+// the chunk of dynamically scheduled loops over cloth particles
+constexpr int64_t kClothChunk = 256;
+
 inline int threadCount() { return omp_get_max_threads(); }
 inline void setThreadCount(int n) {
   if (n > 0) omp_set_num_threads(n);

@@ -259,7 +259,7 @@ void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& n
   Vec3* delta = scratch.delta.data();
   int* count = scratch.deltaCount.data();
 
-  parallelFor(n, [&](int64_t ii) {
+  parallelForDynamic(n, kClothChunk, [&](int64_t ii) {  // folds have more neighbours
     const int i = static_cast<int>(ii);
     const int piece = clothPiece(p.phase[i]);
     if (piece < 0 || piece >= static_cast<int>(model.pieces.size())) return;

@@ -53,6 +53,8 @@ inline __m512 maxPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp
 
 // how far outside a triangle (in barycentric units) a point still counts as on its face
 constexpr float kFaceTolerance = 1e-3f;
+// water particles per chunk of the coupling's dynamically scheduled loops
+constexpr int64_t kWaterChunk = 256;
 // the most sweeps of the rigid pass over a particle's candidates
 constexpr int kRigidSweeps = 4;
 
@@ -271,53 +273,62 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   const int nThreads = omp_get_max_threads();
   s.seen.resize(static_cast<size_t>(nThreads));
   s.seenCloth.resize(static_cast<size_t>(nThreads));
-  s.perThreadCandidates.resize(static_cast<size_t>(nThreads));
-  std::vector<size_t> offset(static_cast<size_t>(nThreads) + 1, 0);
-  // each thread takes one contiguous range of water particles, in order, so concatenating the
-  // per-thread lists gives the candidates in water order for any thread count
+  const int64_t chunks = (nw + kWaterChunk - 1) / kWaterChunk;
+  s.chunkCandidates.resize(static_cast<size_t>(chunks));
+  std::vector<size_t> offset(static_cast<size_t>(chunks) + 1, 0);
+  // chunks of water particles go to whichever thread is free (the water near the sheet is not spread
+  // evenly over the indices); each chunk fills its own list and the lists are joined in water order,
+  // so the candidates do not depend on the thread count
 #pragma omp parallel num_threads(nThreads)
   {
-    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const int t = omp_get_thread_num();
     std::vector<uint32_t>& seen = s.seen[static_cast<size_t>(t)];
     std::vector<uint32_t>& seenCloth = s.seenCloth[static_cast<size_t>(t)];
-    std::vector<uint32_t>& out = s.perThreadCandidates[static_cast<size_t>(t)];
     seen.assign(nTri, ~0u);
     seenCloth.assign(static_cast<size_t>(nc), ~0u);
-    out.clear();
-    const int64_t begin = nw * t / nt, end = nw * (t + 1) / nt;
-    for (int64_t w = begin; w < end; ++w) {
-      const int64_t q = nc + w;
-      const Vec3 a = p.x[q], ab = p.xPred[q] - a;
-      const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
-      float nearest2 = std::numeric_limits<float>::max();
-      int32_t nearest = -1;
-      // cloth particle j lies within reach of the path: its triangles are candidates
-      const auto take = [&](uint32_t j) {
-        if (seenCloth[j] == static_cast<uint32_t>(q)) return;
-        seenCloth[j] = static_cast<uint32_t>(q);
-        const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
-        if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
-        for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
-          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
-          if (seen[tri] == static_cast<uint32_t>(q)) continue;
-          seen[tri] = static_cast<uint32_t>(q);
-          if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
-        }
-      };
-      walkNearPath(grid, a, ab, reachQ, reach, take);
-      s.nearestCloth[static_cast<size_t>(w)] = nearest;
-      s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
+#pragma omp for schedule(dynamic, 1)
+    for (int64_t chunk = 0; chunk < chunks; ++chunk) {
+      std::vector<uint32_t>& out = s.chunkCandidates[static_cast<size_t>(chunk)];
+      out.clear();
+      const int64_t begin = chunk * kWaterChunk, end = std::min(nw, begin + kWaterChunk);
+      for (int64_t w = begin; w < end; ++w) {
+        const int64_t q = nc + w;
+        const Vec3 a = p.x[q], ab = p.xPred[q] - a;
+        const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
+        float nearest2 = std::numeric_limits<float>::max();
+        int32_t nearest = -1;
+        // cloth particle j lies within reach of the path: its triangles are candidates
+        const auto take = [&](uint32_t j) {
+          if (seenCloth[j] == static_cast<uint32_t>(q)) return;
+          seenCloth[j] = static_cast<uint32_t>(q);
+          const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
+          if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
+          for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
+            const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
+            if (seen[tri] == static_cast<uint32_t>(q)) continue;
+            seen[tri] = static_cast<uint32_t>(q);
+            if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
+          }
+        };
+        walkNearPath(grid, a, ab, reachQ, reach, take);
+        s.nearestCloth[static_cast<size_t>(w)] = nearest;
+        s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
+      }
     }
-    offset[static_cast<size_t>(t) + 1] = out.size();
-#pragma omp barrier
 #pragma omp single
     {
-      for (int u = 0; u < nt; ++u) offset[static_cast<size_t>(u) + 1] += offset[static_cast<size_t>(u)];
-      s.candidates.resize(offset[static_cast<size_t>(nt)]);
+      for (int64_t c = 0; c < chunks; ++c)
+        offset[static_cast<size_t>(c) + 1] = offset[static_cast<size_t>(c)] + s.chunkCandidates[static_cast<size_t>(c)].size();
+      s.candidates.resize(offset[static_cast<size_t>(chunks)]);
     }
-    std::copy(out.begin(), out.end(), s.candidates.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(t)]));
-    for (int64_t w = begin; w < end; ++w)
-      s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(offset[static_cast<size_t>(t)]);
+#pragma omp for schedule(static)
+    for (int64_t chunk = 0; chunk < chunks; ++chunk) {
+      const std::vector<uint32_t>& out = s.chunkCandidates[static_cast<size_t>(chunk)];
+      const size_t at = offset[static_cast<size_t>(chunk)];
+      std::copy(out.begin(), out.end(), s.candidates.begin() + static_cast<std::ptrdiff_t>(at));
+      for (int64_t w = chunk * kWaterChunk, end = std::min(nw, w + kWaterChunk); w < end; ++w)
+        s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(at);
+    }
   }
   // the side each water particle came from (Eq. 21's sign), the same for every pass. A triangle's own
   // plane decides only where q started over its face: the plane of a triangle beside q, on a ridge or
@@ -341,7 +352,8 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   if (nc == 0 || n == nc) return 0;
   const int nThreads = omp_get_max_threads();
   const size_t nTri = model.triangles.size();
-  s.perThread.resize(static_cast<size_t>(nThreads));
+  const int64_t nw = n - nc, chunks = (nw + kWaterChunk - 1) / kWaterChunk;
+  s.chunkContacts.resize(static_cast<size_t>(chunks));
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
   // triangle normals once per pass, shared by every water particle that tests the triangle
@@ -360,15 +372,13 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
                                      (p.xPred[f[2]] - c).squaredNorm()}));
   });
 
-  // each thread takes one contiguous range of water particles, in order, so concatenating the
-  // per-thread lists gives the contacts in ascending water order for any thread count
-#pragma omp parallel num_threads(nThreads)
-  {
-    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    std::vector<CouplingContact>& out = s.perThread[static_cast<size_t>(t)];
+  // chunks of water particles go to whichever thread is free; each chunk records its contacts in its
+  // own list, and the lists are summed in water order below, for any thread count
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nThreads)
+  for (int64_t chunk = 0; chunk < chunks; ++chunk) {
+    std::vector<CouplingContact>& out = s.chunkContacts[static_cast<size_t>(chunk)];
     out.clear();
-    const int64_t nw = n - nc;
-    const int64_t begin = nc + nw * t / nt, end = nc + nw * (t + 1) / nt;
+    const int64_t begin = nc + chunk * kWaterChunk, end = std::min(n, begin + kWaterChunk);
     for (int64_t q = begin; q < end; ++q) {
       const uint32_t c0 = s.candidateStart[static_cast<size_t>(q - nc)], c1 = s.candidateStart[static_cast<size_t>(q - nc) + 1];
       if (c0 == c1) continue;
@@ -449,7 +459,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   uint64_t contacts = 0;
   s.clothDelta.assign(static_cast<size_t>(nc), Vec3::Zero());
   s.clothCount.assign(static_cast<size_t>(nc), 0u);
-  for (const auto& list : s.perThread) {
+  for (const auto& list : s.chunkContacts) {
     contacts += list.size();
     if (rigidCloth) continue;
     for (const CouplingContact& c : list) {

@@ -50,13 +50,13 @@ struct TrianglePlane {
 };
 
 struct CouplingScratch {
-  std::vector<std::vector<CouplingContact>> perThread;  // contacts in ascending water order per thread
+  std::vector<std::vector<CouplingContact>> chunkContacts;  // contacts of each chunk of water particles, in water order
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
   std::vector<std::vector<uint32_t>> seenCloth;  // per thread: the water particle that last tested a cloth particle
   ClothBoxGrid clothGrid;                    // the cloth particles alone at their predicted positions
   std::vector<float> vertexReach;            // m, per cloth particle: how near a path it is a candidate
   std::vector<int32_t> nearestCloth;         // per water particle: the cloth particle nearest its start (-1: none)
-  std::vector<std::vector<uint32_t>> perThreadCandidates;
+  std::vector<std::vector<uint32_t>> chunkCandidates;  // candidates of each chunk of water particles
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
   std::vector<float> candidateSide;          // +-1: the side of each candidate the particle came from

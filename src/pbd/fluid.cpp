@@ -15,7 +15,7 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
   const int nc = model.numCloth;
   s.psi.resize(static_cast<size_t>(nc));
   const float rho0 = model.water.restDensity;
-  parallelFor(nc, [&](int64_t b) {
+  parallelForDynamic(nc, kClothChunk, [&](int64_t b) {  // folds and bunches have more neighbours
     const float hb = p.radius[b];
     float sum = poly6(0.0f, hb);  // k includes b itself (NOTES.md on Eq. 10)
     KernelCache kernel;
@@ -213,7 +213,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         s.delta[i] = (Vec3(dx, dy, dz) + rho0 * li * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
       });
       // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
-      parallelFor(nc, [&](int64_t b) {
+      parallelForDynamic(nc, kClothChunk, [&](int64_t b) {  // only the cloth under water has work
         s.delta[b].setZero();
         if (p.invMass[b] == 0.0f) return;
         const float xb = X[3 * b], yb = X[3 * b + 1], zb = X[3 * b + 2], hb = H[b];
