@@ -16,6 +16,14 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
   s.psi.resize(static_cast<size_t>(nc));
   const float rho0 = model.water.restDensity;
   parallelForDynamic(nc, kClothChunk, [&](int64_t b) {  // folds and bunches have more neighbours
+    // Psi_b is read only through water neighbours (the density of water near b, and b's reaction):
+    // a cloth particle with none gets 0 and costs nothing (most of a sheet, most of the time)
+    bool wet = false;
+    for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1] && !wet; ++k) wet = nb.index[k] >= static_cast<uint32_t>(nc);
+    if (!wet) {
+      s.psi[b] = 0.0f;
+      return;
+    }
     const float hb = p.radius[b];
     float sum = poly6(0.0f, hb);  // k includes b itself (NOTES.md on Eq. 10)
     KernelCache kernel;

@@ -13,7 +13,7 @@
 namespace soak {
 
 struct FluidScratch {
-  std::vector<float> psi;          // kg, Akinci boundary mass Psi_b = rho0 V_b of cloth particles
+  std::vector<float> psi;          // kg, Akinci boundary mass Psi_b = rho0 V_b of cloth particles (0 with no water near)
   std::vector<float> density;      // kg/m^3, rho_i of water particles (last iteration)
   std::vector<float> lambda;       // m^2, lambda_i / m_i of the density constraint
   std::vector<Vec3> delta;         // m, position corrections of the current iteration; m/s, velocities after XSPH
@@ -27,7 +27,7 @@ struct FluidScratch {
 };
 
 // Akinci volume of each cloth particle, V_b = 1 / sum_k W_bk over the same piece (Eq. 10), and
-// its boundary mass Psi_b = rho0 V_b
+// its boundary mass Psi_b = rho0 V_b, for the cloth particles with water in their lists (0 elsewhere)
 void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLists& nb, FluidScratch& s);
 
 // the PBF density constraint (Eq. 6-7), `iterations` Jacobi iterations on p.xPred; cloth particles
