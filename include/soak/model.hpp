@@ -87,7 +87,6 @@ struct ClothPiece {
   std::vector<int> panelOfVertex;   // wrinkle subdomains of a procedural garment; empty: patches
 };
 
-// Eq. 8 constraints as a struct of arrays; solved colour by colour (no two share a particle)
 // the order the cloth solver projects a set of constraints in (src/pbd/cloth.cpp). The cloth
 // particles are cut into numSlabs slabs of equal count along the rest shape's longest axis; the
 // constraints are grouped (group g < numSlabs: inside slab g; numSlabs + k: across slabs k and k + 1;
@@ -102,6 +101,7 @@ struct ConstraintSchedule {
   std::vector<int> blockStart;     // constraints of block b: [blockStart[b], blockStart[b + 1])
 };
 
+// Eq. 8 constraints as a struct of arrays, stored in the order of their schedule
 struct StretchConstraints {
   std::vector<std::array<int, 2>> ids;
   std::vector<float> restLength;   // m
