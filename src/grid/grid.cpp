@@ -83,6 +83,75 @@ struct RangeCache {
   }
 };
 
+// the dense grid of buildNeighborLists: false (and nothing built) when the bounding box of x has
+// more than 8 cells a particle (spray far away), or no particles
+bool buildDenseCells(const std::vector<Vec3>& x, float cs, NeighborLists& lists) {
+  const size_t n = x.size();
+  if (n == 0 || !(cs > 0.0f)) return false;
+  Vec3 lo = x[0], hi = x[0];
+  for (const Vec3& p : x) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  if (!lo.allFinite() || !hi.allFinite()) return false;
+  const Vec3 span = (hi - lo) / cs;
+  const double cells = (std::floor(double(span.x())) + 1) * (std::floor(double(span.y())) + 1) * (std::floor(double(span.z())) + 1);
+  if (cells > 8.0 * double(n) + 65536.0) return false;
+  lists.denseOrigin = lo;
+  lists.denseDims = {static_cast<int>(span.x()) + 1, static_cast<int>(span.y()) + 1, static_cast<int>(span.z()) + 1};
+  const Eigen::Vector3i& d = lists.denseDims;
+  lists.denseCell.resize(n);
+  parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
+    const Vec3 c = (x[i] - lo) / cs;
+    const int cx = std::min(static_cast<int>(c.x()), d.x() - 1), cy = std::min(static_cast<int>(c.y()), d.y() - 1),
+              cz = std::min(static_cast<int>(c.z()), d.z() - 1);
+    lists.denseCell[i] = static_cast<uint32_t>((cz * d.y() + cy) * d.x() + cx);
+  });
+  // counting sort, ascending particle order inside a cell
+  std::vector<uint32_t>& start = lists.denseStart;
+  start.assign(static_cast<size_t>(cells) + 1, 0);
+  for (size_t i = 0; i < n; ++i) ++start[lists.denseCell[i] + 1];
+  for (size_t c = 0; c + 1 < start.size(); ++c) start[c + 1] += start[c];
+  lists.denseEntries.resize(n);
+  for (size_t i = 0; i < n; ++i) lists.denseEntries[start[lists.denseCell[i]]++] = static_cast<uint32_t>(i);
+  for (size_t c = start.size() - 1; c > 0; --c) start[c] = start[c - 1];
+  start[0] = 0;
+  return true;
+}
+
+// the candidates of a particle at p in the dense grid: for each of the 9 rows (y, z) around its cell
+// that its reach touches, the cells x - 1 .. x + 1 it touches as one range of the entries
+int denseRowRanges(const NeighborLists& lists, const Vec3& p, float cs, float reach2, uint32_t (*ranges)[2]) {
+  const Eigen::Vector3i& d = lists.denseDims;
+  const Vec3 c = (p - lists.denseOrigin) / cs;
+  const int cell[3] = {std::min(static_cast<int>(c.x()), d.x() - 1), std::min(static_cast<int>(c.y()), d.y() - 1),
+                       std::min(static_cast<int>(c.z()), d.z() - 1)};
+  const float f[3] = {p.x() - (lists.denseOrigin.x() + cs * cell[0]), p.y() - (lists.denseOrigin.y() + cs * cell[1]),
+                      p.z() - (lists.denseOrigin.z() + cs * cell[2])};
+  // squared distance from p to the neighbouring slab at offset o along axis a (0 for its own)
+  const auto gap2 = [&](int a, int o) {
+    const float g = o < 0 ? f[a] : (o > 0 ? cs - f[a] : 0.0f);
+    return g * g;
+  };
+  int count = 0;
+  for (int oz = -1; oz <= 1; ++oz) {
+    const int z = cell[2] + oz;
+    if (z < 0 || z >= d.z()) continue;
+    for (int oy = -1; oy <= 1; ++oy) {
+      const int y = cell[1] + oy;
+      if (y < 0 || y >= d.y()) continue;
+      const float yz2 = gap2(1, oy) + gap2(2, oz);
+      if (yz2 >= reach2) continue;
+      const int x0 = cell[0] > 0 && yz2 + gap2(0, -1) < reach2 ? cell[0] - 1 : cell[0];
+      const int x1 = cell[0] + 1 < d.x() && yz2 + gap2(0, 1) < reach2 ? cell[0] + 1 : cell[0];
+      const size_t row = static_cast<size_t>(z * d.y() + y) * d.x();
+      const uint32_t k0 = lists.denseStart[row + x0], k1 = lists.denseStart[row + x1 + 1];
+      if (k0 == k1) continue;
+      ranges[count][0] = k0;
+      ranges[count][1] = k1;
+      ++count;
+    }
+  }
+  return count;
+}
+
 }  // namespace
 
 void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
@@ -101,9 +170,14 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   float* py = lists.py.data();
   float* pz = lists.pz.data();
   float* ph = lists.ph.data();
-  const uint32_t* entries = grid.cellEntries.data();
   const float cs = grid.cellSize;
   const bool parallel = static_cast<int64_t>(n) >= kParallelGrain;
+  // a dense grid over the particles' bounding box (cells of the same size, x fastest) when it has no
+  // more than 8 cells a particle: then the three cells of a row around a particle are one range of
+  // the sorted entries, 9 ranges of about 3 cells instead of 27 of one. Else the hashed grid's buckets
+  const bool dense = buildDenseCells(x, cs, lists);
+  lists.dense = dense;
+  const uint32_t* entries = dense ? lists.denseEntries.data() : grid.cellEntries.data();
   parallelFor(static_cast<int64_t>(n), [&](int64_t k) {
     const uint32_t j = entries[k];
     px[k] = x[j].x();
@@ -118,14 +192,25 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   const auto gather = [&](size_t i, RangeCache& cache, std::vector<uint32_t>& cl, std::vector<uint32_t>& wa,
                           uint32_t& nCloth, uint32_t& nWater) {
     const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
-    const Eigen::Vector3i c = grid.cellOf(x[i]);
-    cache.lookup(grid, c);
-    const float f[3] = {xi - cs * c.x(), yi - cs * c.y(), zi - cs * c.z()};
     const float reach = 0.5f * (hi + cs) * 1.001f, reach2 = reach * reach;  // margin for rounding
+    uint32_t ranges[27][2];
+    int count = 0;
+    if (dense) {
+      count = denseRowRanges(lists, x[i], cs, reach2, ranges);
+    } else {
+      const Eigen::Vector3i c = grid.cellOf(x[i]);
+      cache.lookup(grid, c);
+      const float f[3] = {xi - cs * c.x(), yi - cs * c.y(), zi - cs * c.z()};
+      for (int r = 0; r < cache.count; ++r) {
+        if (!RangeCache::touches(cache.offset[r], f, cs, reach2)) continue;
+        ranges[count][0] = cache.ranges[r][0];
+        ranges[count][1] = cache.ranges[r][1];
+        ++count;
+      }
+    }
     uint32_t ncl = 0, nwa = 0;
-    for (int r = 0; r < cache.count; ++r) {
-      if (!RangeCache::touches(cache.offset[r], f, cs, reach2)) continue;
-      const uint32_t k0 = cache.ranges[r][0], k1 = cache.ranges[r][1];
+    for (int r = 0; r < count; ++r) {
+      const uint32_t k0 = ranges[r][0], k1 = ranges[r][1];
       if (ncl + (k1 - k0) + 16 > cl.size()) cl.resize(2 * (ncl + (k1 - k0) + 16));  // + 16: whole-vector stores
       if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));
       uint32_t* pc = cl.data();

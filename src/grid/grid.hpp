@@ -71,6 +71,12 @@ struct NeighborLists {
   uint32_t firstWater = 0;              // the index split the lists were built with
   std::vector<float> px, py, pz, ph;   // scratch of the build: candidates' positions and radii in cellEntries order
   std::vector<std::vector<uint32_t>> chunkBuffers;  // scratch of the build: the lists of one round's chunks
+  // scratch of the build: a dense grid of the particles' bounding box (buildNeighborLists); dense
+  // tells whether the last build used it or the hashed grid's buckets
+  bool dense = false;
+  Vec3 denseOrigin = Vec3::Zero();
+  Eigen::Vector3i denseDims{0, 0, 0};
+  std::vector<uint32_t> denseStart, denseEntries, denseCell;
   uint32_t count(size_t i) const { return start[i + 1] - start[i]; }
   // the cloth neighbours of i when the lists were built with firstWater = numCloth, else all
   uint32_t clothEnd(size_t i, uint32_t numCloth) const { return firstWater == numCloth ? mid[i] : start[i + 1]; }

@@ -39,19 +39,23 @@ std::vector<std::vector<uint32_t>> bruteForce(const std::vector<Vec3>& x, const 
 }
 }  // namespace
 
-class GridVsBruteForce : public ::testing::TestWithParam<std::tuple<bool, unsigned>> {};
+// (mixed radii, seed, a far cluster): with the far cluster the bounding box has too many cells and the
+// lists come from the hashed grid's buckets; without, from the dense grid's rows
+class GridVsBruteForce : public ::testing::TestWithParam<std::tuple<bool, unsigned, bool>> {};
 
 TEST_P(GridVsBruteForce, SameNeighbours) {
-  const auto [mixed, seed] = GetParam();
+  const auto [mixed, seed, far] = GetParam();
   std::vector<Vec3> x;
   std::vector<float> r;
   randomSet(3000, 0.25f, mixed, seed, x, r);
   // negative coordinates and a far cluster exercise the hash
-  for (int k = 0; k < 200; ++k) x[k] += Vec3(37.0f, -12.0f, 5.0f);
+  if (far)
+    for (int k = 0; k < 200; ++k) x[k] += Vec3(37.0f, -12.0f, 5.0f);
   NeighborGrid grid;
   NeighborLists lists;
   buildGrid(x, *std::max_element(r.begin(), r.end()), grid);
   buildNeighborLists(x, r, grid, lists);
+  EXPECT_EQ(lists.dense, !far);  // the path the case means to test
   const auto ref = bruteForce(x, r);
   size_t total = 0;
   for (size_t i = 0; i < x.size(); ++i) {
@@ -62,7 +66,7 @@ TEST_P(GridVsBruteForce, SameNeighbours) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Grid, GridVsBruteForce,
-                         ::testing::Combine(::testing::Bool(), ::testing::Values(1u, 2u, 3u)));
+                         ::testing::Combine(::testing::Bool(), ::testing::Values(1u, 2u, 3u), ::testing::Bool()));
 
 // grid and lists of x built on `threads` threads, cloth before water at `split`
 NeighborLists listsOn(int threads, const std::vector<Vec3>& x, const std::vector<float>& r, uint32_t split) {
