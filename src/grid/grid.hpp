@@ -1,6 +1,7 @@
 // neighbour search: a hashed uniform grid filled by counting sort (cellStart / cellEntries), rebuilt
-// every step without allocation after warm-up, and per-particle neighbour lists built from it.
-// Two particles are neighbours when |x_i - x_j| < h_ij = (h_i + h_j) / 2 (per-particle radii).
+// every step without allocation after warm-up, and per-particle neighbour lists built from it (from a
+// dense grid of the particles' bounding box with the same cells when that is small enough: the cells
+// of a row are then one range). Two particles are neighbours when |x_i - x_j| < h_ij = (h_i + h_j) / 2 (per-particle radii).
 #pragma once
 #include <soak/math.hpp>
 
