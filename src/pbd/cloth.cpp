@@ -270,16 +270,20 @@ void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& n
     const auto ringEnd = model.vertexNeighbors.begin() + model.vertexNeighborStart[i + 1];
     Vec3 sum = Vec3::Zero();
     int contacts = 0;
+    const Vec3 xi = x[i];
+    const float t2 = thickness * thickness;
     for (uint32_t s = neighbors.start[i], end = neighbors.clothEnd(i, static_cast<uint32_t>(n)); s < end; ++s) {
       const int j = static_cast<int>(neighbors.index[s]);
-      if (j >= n || j == i || p.phase[j] != p.phase[i]) continue;
+      if (j >= n) continue;
+      // the distance first: nearly every neighbour (within h) is farther than the thickness
+      const Vec3 xij = xi - x[j];
+      const float dist2 = xij.squaredNorm();
+      if (dist2 >= t2 || dist2 < 1e-24f) continue;
+      if (j == i || p.phase[j] != p.phase[i]) continue;
       const float wSum = w[i] + w[j];
       if (wSum == 0.0f) continue;
-      const Vec3 xij = x[i] - x[j];
-      const float dist2 = xij.squaredNorm();
-      if (dist2 >= thickness * thickness || dist2 < 1e-24f) continue;
       // pairs that are this close at rest belong together (fine meshes, seams): leave them to Eq. 8
-      if ((rest[i] - rest[j]).squaredNorm() <= thickness * thickness) continue;
+      if ((rest[i] - rest[j]).squaredNorm() <= t2) continue;
       if (std::binary_search(ringBegin, ringEnd, j)) continue;
       const float dist = std::sqrt(dist2);
       sum += (w[i] / wSum * (thickness - dist) / dist) * xij;
