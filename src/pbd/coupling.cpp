@@ -232,12 +232,16 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   s.candidateStart.assign(static_cast<size_t>(nw) + 1, 0);
   const size_t nTri = model.triangles.size();
   // the triangles' normals at the start of the substep: p.x does not change during the passes
+  // and each triangle's longest edge at the predicted positions (squared), for the reach below
   s.startNormal.resize(nTri);
+  s.triangleEdge2.resize(nTri);
   parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
     const auto& f = model.triangles[t];
     const Vec3 n0 = (p.x[f[1]] - p.x[f[0]]).cross(p.x[f[2]] - p.x[f[0]]);
     const float l0 = n0.norm();
     s.startNormal[t] = l0 > 1e-12f ? Vec3(n0 / l0) : Vec3::Zero();
+    s.triangleEdge2[t] = std::max({(p.xPred[f[0]] - p.xPred[f[1]]).squaredNorm(), (p.xPred[f[1]] - p.xPred[f[2]]).squaredNorm(),
+                                   (p.xPred[f[2]] - p.xPred[f[0]]).squaredNorm()});
   });
   // how far from a water particle's path each cloth particle j can be and still have a triangle that
   // the passes may find within d of the path: d and half of it (the lateral allowance of a contact)
@@ -254,11 +258,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
       const int v = model.vertexNeighbors[k];
       shift2 = std::max(shift2, (p.xPred[v] - p.x[v]).squaredNorm());
     }
-    for (int k = model.vertexTriangleStart[j]; k < model.vertexTriangleStart[j + 1]; ++k) {
-      const auto& f = model.triangles[static_cast<size_t>(model.vertexTriangles[k])];
-      edge2 = std::max({edge2, (p.xPred[f[0]] - p.xPred[f[1]]).squaredNorm(), (p.xPred[f[1]] - p.xPred[f[2]]).squaredNorm(),
-                        (p.xPred[f[2]] - p.xPred[f[0]]).squaredNorm()});
-    }
+    for (int k = model.vertexTriangleStart[j]; k < model.vertexTriangleStart[j + 1]; ++k)
+      edge2 = std::max(edge2, s.triangleEdge2[static_cast<size_t>(model.vertexTriangles[k])]);
     const float thickness = model.pieces[clothPiece(p.phase[j])].material.thickness;
     s.vertexReach[j] = 2.0f * thickness + std::sqrt(edge2 / 3.0f) + std::sqrt(shift2);
   });

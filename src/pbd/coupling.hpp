@@ -54,6 +54,7 @@ struct CouplingScratch {
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
   std::vector<std::vector<uint32_t>> seenCloth;  // per thread: the water particle that last tested a cloth particle
   ClothBoxGrid clothGrid;                    // the cloth particles alone at their predicted positions
+  std::vector<float> triangleEdge2;          // m^2, each triangle's longest edge at the predicted positions, squared
   std::vector<float> vertexReach;            // m, per cloth particle: how near a path it is a candidate
   std::vector<int32_t> nearestCloth;         // per water particle: the cloth particle nearest its start (-1: none)
   std::vector<std::vector<uint32_t>> chunkCandidates;  // candidates of each chunk of water particles
