@@ -153,6 +153,15 @@ float candidateSideOf(const Model& model, const Particles& p, const CouplingScra
   return over.minCoeff() >= -kFaceTolerance ? own : sheetSide;
 }
 
+// q's signed distance to the start plane of triangle tri when q starts over its face, else +infinity
+float overFaceDistance(const Model& model, const Particles& p, const CouplingScratch& s, uint32_t tri, const Vec3& xq0) {
+  const auto& f = model.triangles[tri];
+  const Vec3& n0 = s.startNormal[tri];
+  const float dist = (xq0 - p.x[f[0]]).dot(n0);
+  const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
+  return over.minCoeff() >= -kFaceTolerance ? dist : std::numeric_limits<float>::infinity();
+}
+
 // calls take(j) for every cloth particle j of the grid within min(reachQ, its own reach) of the path
 // a -> a + ab (each may come more than once); reach: the largest such distance
 template <class Take>
@@ -343,7 +352,22 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
     const uint32_t c0 = s.candidateStart[static_cast<size_t>(w)], c1 = s.candidateStart[static_cast<size_t>(w) + 1];
     const float sheetSide = sheetSideOf(p, s, s.nearestCloth[static_cast<size_t>(w)], xq0);
-    for (uint32_t c = c0; c < c1; ++c) s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, sheetSide);
+    bool conflict = false;  // q starts over a face whose plane puts it on the other side
+    for (uint32_t c = c0; c < c1; ++c) {
+      s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, sheetSide);
+      conflict |= s.candidateSide[c] != sheetSide;
+    }
+    if (!conflict) return;
+    // the nearest face q starts over knows its side better than the smoothed normal at the nearest
+    // particle (q within a millimetre of a curved sheet: the two can disagree, and the triangles beside
+    // q then pushed it through the face under it)
+    float nearest = std::numeric_limits<float>::max(), side = sheetSide;
+    for (uint32_t c = c0; c < c1; ++c) {
+      const float dist = overFaceDistance(model, p, s, s.candidates[c], xq0);
+      if (std::fabs(dist) < nearest) nearest = std::fabs(dist), side = dist >= 0.0f ? 1.0f : -1.0f;
+    }
+    if (side == sheetSide) return;
+    for (uint32_t c = c0; c < c1; ++c) s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, side);
   });
 }
 

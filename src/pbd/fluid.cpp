@@ -5,6 +5,10 @@
 #include "core/kernels.hpp"
 #include "core/parallel.hpp"
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -108,13 +112,246 @@ bool commonRadius(const std::vector<float>& radius, float& h) {
   return lo == radius.end() || *lo == *hi;
 }
 
+// what the pair loops of one solver pass read: the positions, radii, masses (Psi for cloth), inverse
+// masses and lambdas of every particle, and the pass's constants
+struct PairInputs {
+  const float* X;          // xPred, 3 floats a particle
+  const float* H;          // support radius
+  const float* M;          // m_j for water, Psi_j for cloth (massOrPsi)
+  const float* W;          // inverse mass
+  const float* L;          // lambda (0 for cloth)
+  const float* mass;       // the particle's own mass
+  const int32_t* phase;
+  const uint32_t* index;   // neighbour lists
+  float hU, invU;          // the common radius and its reciprocal (uniform case)
+  float invRho0;
+  float sCorrK, oneMinusDq2;
+  int tensileN;
+};
+
+#if defined(__AVX512F__)
+// With AVX-512, the pair sums below take 16 neighbours at a time: j's data are gathered, every lane
+// does the scalar loop's arithmetic for its pair (same operations, same order, no FMA), and the sums
+// are kept per lane and added across lanes at the end. Lanes past the list's end gather nothing (mass
+// 0, masked kernels): they add +0. Lists shorter than kSimdMinPairs (spray) take the scalar loop,
+// which is then faster. The order of the sums depends on the list's length, never on the thread
+// count; results differ from a build without AVX-512 in the last bits. Hand-written: GCC 12
+// vectorised these loops with scalar loads in place of gathers, slower than scalar (docs/performance.md).
+constexpr uint32_t kSimdMinPairs = 4;
+namespace v16 {
+inline __m512 set(float x) { return _mm512_set1_ps(x); }
+inline __m512 add(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
+inline __m512 sub(__m512 a, __m512 b) { return _mm512_sub_ps(a, b); }
+inline __m512 mul(__m512 a, __m512 b) { return _mm512_mul_ps(a, b); }
+inline __mmask16 lanes(uint32_t k, uint32_t end) {
+  return end - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (end - k)) - 1u);
+}
+// the kernel constants of the lanes' pairs: h, h^2, the poly6 and spiky coefficients (poly6CoefOf,
+// spikyCoefOf); loop constants when every radius is equal
+struct Kernel {
+  __m512 h, h2, poly6, spiky;
+};
+template <bool U>
+inline Kernel kernelOf(const PairInputs& in, __mmask16 m, __m512i j, float hi) {
+  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOf(in.invU)), set(spikyCoefOf(in.invU))};
+  const __m512 hj = _mm512_mask_i32gather_ps(set(hi), m, j, in.H, 4);
+  const __m512 h = mul(set(0.5f), add(set(hi), hj));
+  const __m512 inv = _mm512_div_ps(set(1.0f), h);
+  const __m512 inv3 = mul(mul(inv, inv), inv), inv6 = mul(inv3, inv3);
+  return {h, mul(h, h), mul(mul(set(315.0f / (64.0f * kPi)), inv6), inv3), mul(set(-45.0f / kPi), inv6)};
+}
+// spikyFactorOf per lane, 0 outside the support, at r = 0 and in masked lanes
+inline __m512 spikyFactor(const Kernel& k, __m512 r2, __mmask16 m) {
+  const __m512 len = _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), r2), d = sub(k.h, len);
+  const __mmask16 in = _mm512_mask_cmp_ps_mask(m, len, k.h, _CMP_LT_OQ) & _mm512_cmp_ps_mask(len, set(1e-9f), _CMP_GT_OQ);
+  return _mm512_maskz_div_ps(in, mul(mul(k.spiky, d), d), len);
+}
+// the lanes' sum as a fixed tree (halves, quarters, pairs). The maskz forms here and in spikyFactor
+// (all lanes): GCC 12's headers draw -Wmaybe-uninitialized from the plain ones
+inline float sum(__m512 a) {
+  constexpr __mmask16 all = 0xFFFF;
+  a = add(a, _mm512_maskz_shuffle_f32x4(all, a, a, 0x4E));
+  a = add(a, _mm512_maskz_shuffle_f32x4(all, a, a, 0xB1));
+  a = add(a, _mm512_maskz_permute_ps(all, a, 0x4E));
+  a = add(a, _mm512_maskz_permute_ps(all, a, 0xB1));
+  return _mm512_cvtss_f32(a);
+}
+}  // namespace v16
+#endif
+
+// lambda pass of water particle i over its neighbours [k0, k1): rho_i without itself, grad_i C_i
+// without the walls (times rho0) and sum_j w_j |grad_j C_i|^2
+template <bool U>
+inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1, float& rho, Vec3& grad,
+                        float& sumOthers) {
+  const float* X = in.X;
+  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = in.H[i];
+  float r = 0.0f, gx = 0.0f, gy = 0.0f, gz = 0.0f, so = 0.0f;
+  uint32_t k = k0;
+#if defined(__AVX512F__)
+  if (k1 - k0 >= kSimdMinPairs) {
+    using namespace v16;
+    const __m512 vx = set(xi), vy = set(yi), vz = set(zi), zero = _mm512_setzero_ps();
+    __m512 sRho = zero, sGx = zero, sGy = zero, sGz = zero, sOthers = zero;
+    for (; k < k1; k += 16) {
+      const __mmask16 m = lanes(k, k1);
+      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k), j3 = _mm512_add_epi32(j, _mm512_add_epi32(j, j));
+      const __m512 rx = sub(vx, _mm512_mask_i32gather_ps(zero, m, j3, X, 4));
+      const __m512 ry = sub(vy, _mm512_mask_i32gather_ps(zero, m, j3, X + 1, 4));
+      const __m512 rz = sub(vz, _mm512_mask_i32gather_ps(zero, m, j3, X + 2, 4));
+      const __m512 mj = _mm512_mask_i32gather_ps(zero, m, j, in.M, 4), wj = _mm512_mask_i32gather_ps(zero, m, j, in.W, 4);
+      const Kernel kern = kernelOf<U>(in, m, j, hi);
+      const __m512 r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz));
+      const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
+      sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
+      const __m512 f = mul(mul(mj, set(in.invRho0)), spikyFactor(kern, r2, m));
+      sGx = add(sGx, mul(f, rx));
+      sGy = add(sGy, mul(f, ry));
+      sGz = add(sGz, mul(f, rz));
+      sOthers = add(sOthers, mul(mul(mul(wj, f), f), r2));
+    }
+    r = sum(sRho);
+    gx = sum(sGx), gy = sum(sGy), gz = sum(sGz);
+    so = sum(sOthers);
+    k = k1;
+  }
+#endif
+  for (; k < k1; ++k) {
+    const uint32_t j = in.index[k];
+    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+    const float r2 = rx * rx + ry * ry + rz * rz;
+    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]), kinv = U ? in.invU : 1.0f / kh;
+    const float mj = in.M[j];
+    r += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
+    const float f = mj * in.invRho0 * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
+    gx += f * rx;
+    gy += f * ry;
+    gz += f * rz;
+    so += in.W[j] * f * f * r2;
+  }
+  rho = r;
+  grad = Vec3(gx, gy, gz);
+  sumOthers = so;
+}
+
+// correction pass of water particle i: sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (a cloth
+// neighbour has lambda 0 and no s_corr)
+template <bool U, bool Tensile>
+inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
+  const float* X = in.X;
+  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = in.H[i], li = in.L[i];
+  float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+  uint32_t k = k0;
+#if defined(__AVX512F__)
+  if (k1 - k0 >= kSimdMinPairs) {
+    using namespace v16;
+    const __m512 vx = set(xi), vy = set(yi), vz = set(zi), vli = set(li), zero = _mm512_setzero_ps();
+    __m512 sx = zero, sy = zero, sz = zero;
+    for (; k < k1; k += 16) {
+      const __mmask16 m = lanes(k, k1);
+      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k), j3 = _mm512_add_epi32(j, _mm512_add_epi32(j, j));
+      const __m512 rx = sub(vx, _mm512_mask_i32gather_ps(zero, m, j3, X, 4));
+      const __m512 ry = sub(vy, _mm512_mask_i32gather_ps(zero, m, j3, X + 1, 4));
+      const __m512 rz = sub(vz, _mm512_mask_i32gather_ps(zero, m, j3, X + 2, 4));
+      const __m512 mj = _mm512_mask_i32gather_ps(zero, m, j, in.M, 4), lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
+      const Kernel kern = kernelOf<U>(in, m, j, hi);
+      const __m512 r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz));
+      __m512 sc = zero;
+      if (Tensile) {  // s_corr = sCorrK tensileCorrection(1, ...) for water neighbours
+        const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
+        const __mmask16 water = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase));
+        const __m512 q = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero), mul(kern.h2, set(in.oneMinusDq2)));
+        __m512 base = mul(mul(q, q), q), power = set(1.0f);
+        for (int bit = 0; bit < 6; ++bit) {
+          if ((in.tensileN >> bit) & 1) power = mul(power, base);
+          base = mul(base, base);
+        }
+        sc = _mm512_maskz_mul_ps(water, set(in.sCorrK), mul(set(-1.0f), power));
+      }
+      const __m512 f = mul(mul(mj, add(add(vli, lj), sc)), spikyFactor(kern, r2, m));
+      sx = add(sx, mul(f, rx));
+      sy = add(sy, mul(f, ry));
+      sz = add(sz, mul(f, rz));
+    }
+    dx = sum(sx), dy = sum(sy), dz = sum(sz);
+    k = k1;
+  }
+#endif
+  for (; k < k1; ++k) {
+    const uint32_t j = in.index[k];
+    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+    const float r2 = rx * rx + ry * ry + rz * rz;
+    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]), kinv = U ? in.invU : 1.0f / kh;
+    const float sc = Tensile && in.phase[j] == kWaterPhase
+                         ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, r2, kh * kh)
+                         : 0.0f;
+    const float f = in.M[j] * (li + in.L[j] + sc) * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
+    dx += f * rx;
+    dy += f * ry;
+    dz += f * rz;
+  }
+  return Vec3(dx, dy, dz);
+}
+
+// cloth reaction of cloth particle b over its water neighbours [k0, k1): -sum_i m_i lambda_i grad W_ib
+// over the water that pushes (lambda != 0); returns how many push
+template <bool U>
+inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1, Vec3& sumOut) {
+  const float* X = in.X;
+  const float xb = X[3 * b], yb = X[3 * b + 1], zb = X[3 * b + 2], hb = in.H[b];
+  int pushing = 0;
+  float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+  uint32_t k = k0;
+#if defined(__AVX512F__)
+  if (k1 - k0 >= kSimdMinPairs) {
+    using namespace v16;
+    const __m512 vx = set(xb), vy = set(yb), vz = set(zb), zero = _mm512_setzero_ps();
+    __m512 sx = zero, sy = zero, sz = zero;
+    for (; k < k1; k += 16) {
+      const __mmask16 m = lanes(k, k1);
+      const __m512i i = _mm512_maskz_loadu_epi32(m, in.index + k);
+      const __m512 li = _mm512_mask_i32gather_ps(zero, m, i, in.L, 4);
+      const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, i, in.phase, 4);
+      // only compressed water pushes
+      const __mmask16 push = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase)) &
+                             _mm512_cmp_ps_mask(li, zero, _CMP_NEQ_UQ);
+      if (!push) continue;
+      const __m512i i3 = _mm512_add_epi32(i, _mm512_add_epi32(i, i));
+      const __m512 rx = sub(_mm512_mask_i32gather_ps(zero, push, i3, X, 4), vx);
+      const __m512 ry = sub(_mm512_mask_i32gather_ps(zero, push, i3, X + 1, 4), vy);
+      const __m512 rz = sub(_mm512_mask_i32gather_ps(zero, push, i3, X + 2, 4), vz);
+      const __m512 mi = _mm512_mask_i32gather_ps(zero, push, i, in.mass, 4);
+      const Kernel kern = kernelOf<U>(in, push, i, hb);
+      const __m512 r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz));
+      const __m512 f = mul(mul(mi, li), spikyFactor(kern, r2, push));
+      sx = sub(sx, mul(f, rx));
+      sy = sub(sy, mul(f, ry));
+      sz = sub(sz, mul(f, rz));
+      pushing += __builtin_popcount(push);
+    }
+    dx = sum(sx), dy = sum(sy), dz = sum(sz);
+    k = k1;
+  }
+#endif
+  for (; k < k1; ++k) {
+    const uint32_t i = in.index[k];
+    if (in.phase[i] != kWaterPhase || in.L[i] == 0.0f) continue;  // only compressed water pushes
+    const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
+    const float kh = U ? in.hU : 0.5f * (in.H[i] + hb), kinv = U ? in.invU : 1.0f / kh;
+    const float f = in.mass[i] * in.L[i] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz);
+    dx -= f * rx;
+    dy -= f * ry;
+    dz -= f * rz;
+    ++pushing;
+  }
+  sumOut = Vec3(dx, dy, dz);
+  return pushing;
+}
+
 }  // namespace
 
-// The neighbour loops are scalar: vectorised (omp simd), GCC 12 emulates the gathers of j's data
-// with scalar loads on Zen 4 and the PBF passes took 19.5 ms per step at 1 thread against 17.2
-// scalar; real gather instructions (-mtune-ctrl=use_gather) were no faster (docs/performance.md).
-// (Until session 6 they carried omp simd pragmas that GCC silently did not honour: the PairKernel
-// struct in the loop body became a per-lane array.)
+// The solver's neighbour loops are densitySums, correctionSum and reactionSum above (AVX-512 by hand
+// where available); the velocity pass below is scalar (once a substep).
 void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
                 FluidScratch& s, int iterations) {
   const WaterParams& wp = model.water;
@@ -148,43 +385,23 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   }
   // the mass a neighbour lends the density: its own for water, the boundary mass Psi_b for cloth
   parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.massOrPsi[j] = j < nc ? s.psi[j] : p.mass[j]; });
-  const float* X = p.xPred[0].data();
   const float* H = p.radius.data();
-  const float* M = s.massOrPsi.data();
-  const float* W = p.invMass.data();
   const float* L = s.lambda.data();
-  const int32_t* phase = p.phase.data();
-  const uint32_t* index = nb.index.data();
-
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
-  const float invU = 1.0f / hU;
+  const PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
+                      nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
   const auto solve = [&](auto uniform, auto tensile) {
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (int it = 0; it < iterations; ++it) {
       // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
       parallelFor(nw, [&](int64_t w) {
         const size_t i = static_cast<size_t>(nc + w);
-        const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
         const float hi = H[i], mi = p.mass[i];
-        float rho = 0.0f, gx = 0.0f, gy = 0.0f, gz = 0.0f;
-        float sumOthers = 0.0f;  // sum over neighbours of w_k |grad_k C|^2
-
-        for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
-          const uint32_t j = index[k];
-          const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-          const float r2 = rx * rx + ry * ry + rz * rz;
-          const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
-          const float mj = M[j];
-          rho += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
-          const float f = mj * invRho0 * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
-          gx += f * rx;
-          gy += f * ry;
-          gz += f * rz;
-          sumOthers += W[j] * f * f * r2;
-        }
+        float rho = 0.0f, sumOthers = 0.0f;  // sumOthers: sum over neighbours of w_k |grad_k C|^2
+        Vec3 gradI;
+        densitySums<U>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
         rho += mi * poly6(0.0f, hi);
-        Vec3 gradI(gx, gy, gz);
         // colliders as a continuous wall of boundary particles, skipped while the particle cannot have
         // come within h of one (exact: a part beyond h adds nothing)
         Vec3 gradWall = -Vec3::Zero();
@@ -203,45 +420,18 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       // a cloth neighbour has lambda 0 and no s_corr: Psi_b lambda_i grad W_ib
       parallelFor(nw, [&](int64_t w) {
         const size_t i = static_cast<size_t>(nc + w);
-        const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
-        const float hi = H[i], li = L[i];
-        float dx = 0.0f, dy = 0.0f, dz = 0.0f;
-
-        for (uint32_t k = nb.start[i]; k < nb.start[i + 1]; ++k) {
-          const uint32_t j = index[k];
-          const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-          const float r2 = rx * rx + ry * ry + rz * rz;
-          const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
-          const float sc = Tensile && phase[j] == kWaterPhase ? sCorrK * tensileCorrection(1.0f, oneMinusDq2, tensileN, r2, kh * kh) : 0.0f;
-          const float f = M[j] * (li + L[j] + sc) * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
-          dx += f * rx;
-          dy += f * ry;
-          dz += f * rz;
-        }
-        s.delta[i] = (Vec3(dx, dy, dz) + rho0 * li * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
+        const Vec3 sumJ = correctionSum<U, Tensile>(in, i, nb.start[i], nb.start[i + 1]);
+        s.delta[i] = (sumJ + rho0 * L[i] * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
       });
       // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
       parallelForDynamic(nc, kClothChunk, [&](int64_t b) {  // only the cloth under water has work
         s.delta[b].setZero();
         if (p.invMass[b] == 0.0f) return;
-        const float xb = X[3 * b], yb = X[3 * b + 1], zb = X[3 * b + 2], hb = H[b];
-        float dx = 0.0f, dy = 0.0f, dz = 0.0f;
-        int pushing = 0;
-
-        for (uint32_t k = nb.waterBegin(b, static_cast<uint32_t>(nc)); k < nb.start[b + 1]; ++k) {
-          const uint32_t i = index[k];
-          if (phase[i] != kWaterPhase || L[i] == 0.0f) continue;  // only compressed water pushes
-          const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
-          const float kh = U ? hU : 0.5f * (H[i] + hb), kinv = U ? invU : 1.0f / kh;
-          const float f = p.mass[i] * L[i] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz);
-          dx -= f * rx;
-          dy -= f * ry;
-          dz -= f * rz;
-          ++pushing;
-        }
+        Vec3 sumI;
+        const int pushing = reactionSum<U>(in, static_cast<size_t>(b), nb.waterBegin(b, static_cast<uint32_t>(nc)), nb.start[b + 1], sumI);
         // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
         // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
-        if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * Vec3(dx, dy, dz);
+        if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * sumI;
       });
       parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
         if (i >= nc || p.invMass[i] != 0.0f) p.xPred[i] += s.delta[i];
