@@ -146,6 +146,27 @@ inline __m512 mul(__m512 a, __m512 b) { return _mm512_mul_ps(a, b); }
 inline __mmask16 lanes(uint32_t k, uint32_t end) {
   return end - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (end - k)) - 1u);
 }
+// the lanes' pairs of particle i: j = index[k .. min(k + 16, end)) (mask m) and r = x_i - x_j,
+// r2 = |r|^2 as the scalar loop rounds it; lanes past end gather 0
+struct Pairs {
+  __mmask16 m;
+  __m512i j;
+  __m512 rx, ry, rz, r2;
+};
+inline Pairs pairsAt(const PairInputs& in, uint32_t k, uint32_t end, __m512 xi, __m512 yi, __m512 zi) {
+  const __m512 zero = _mm512_setzero_ps();
+  Pairs q;
+  q.m = lanes(k, end);
+  q.j = _mm512_maskz_loadu_epi32(q.m, in.index + k);
+  const __m512i j3 = _mm512_add_epi32(q.j, _mm512_add_epi32(q.j, q.j));
+  q.rx = sub(xi, _mm512_mask_i32gather_ps(zero, q.m, j3, in.X, 4));
+  q.ry = sub(yi, _mm512_mask_i32gather_ps(zero, q.m, j3, in.X + 1, 4));
+  q.rz = sub(zi, _mm512_mask_i32gather_ps(zero, q.m, j3, in.X + 2, 4));
+  q.r2 = add(add(mul(q.rx, q.rx), mul(q.ry, q.ry)), mul(q.rz, q.rz));
+  return q;
+}
+// a[j] of the lanes' neighbours (0 past the list's end)
+inline __m512 gatherOf(const Pairs& q, const float* a) { return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), q.m, q.j, a, 4); }
 // the kernel constants of the lanes' pairs: h, h^2, the poly6 and spiky coefficients (poly6CoefOf,
 // spikyCoefOf); loop constants when every radius is equal
 struct Kernel {
@@ -194,14 +215,12 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
     const __m512 vx = set(xi), vy = set(yi), vz = set(zi), zero = _mm512_setzero_ps();
     __m512 sRho = zero, sGx = zero, sGy = zero, sGz = zero, sOthers = zero;
     for (; k < k1; k += 16) {
-      const __mmask16 m = lanes(k, k1);
-      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k), j3 = _mm512_add_epi32(j, _mm512_add_epi32(j, j));
-      const __m512 rx = sub(vx, _mm512_mask_i32gather_ps(zero, m, j3, X, 4));
-      const __m512 ry = sub(vy, _mm512_mask_i32gather_ps(zero, m, j3, X + 1, 4));
-      const __m512 rz = sub(vz, _mm512_mask_i32gather_ps(zero, m, j3, X + 2, 4));
-      const __m512 mj = _mm512_mask_i32gather_ps(zero, m, j, in.M, 4), wj = _mm512_mask_i32gather_ps(zero, m, j, in.W, 4);
+      const Pairs q = pairsAt(in, k, k1, vx, vy, vz);
+      const __mmask16 m = q.m;
+      const __m512i j = q.j;
+      const __m512 rx = q.rx, ry = q.ry, rz = q.rz, r2 = q.r2;
+      const __m512 mj = gatherOf(q, in.M), wj = gatherOf(q, in.W);
       const Kernel kern = kernelOf<U>(in, m, j, hi);
-      const __m512 r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz));
       const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
       sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
       const __m512 f = mul(mul(mj, set(in.invRho0)), spikyFactor(kern, r2, m));
@@ -248,14 +267,12 @@ inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t 
     const __m512 vx = set(xi), vy = set(yi), vz = set(zi), vli = set(li), zero = _mm512_setzero_ps();
     __m512 sx = zero, sy = zero, sz = zero;
     for (; k < k1; k += 16) {
-      const __mmask16 m = lanes(k, k1);
-      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k), j3 = _mm512_add_epi32(j, _mm512_add_epi32(j, j));
-      const __m512 rx = sub(vx, _mm512_mask_i32gather_ps(zero, m, j3, X, 4));
-      const __m512 ry = sub(vy, _mm512_mask_i32gather_ps(zero, m, j3, X + 1, 4));
-      const __m512 rz = sub(vz, _mm512_mask_i32gather_ps(zero, m, j3, X + 2, 4));
-      const __m512 mj = _mm512_mask_i32gather_ps(zero, m, j, in.M, 4), lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
+      const Pairs q = pairsAt(in, k, k1, vx, vy, vz);
+      const __mmask16 m = q.m;
+      const __m512i j = q.j;
+      const __m512 rx = q.rx, ry = q.ry, rz = q.rz, r2 = q.r2;
+      const __m512 mj = gatherOf(q, in.M), lj = gatherOf(q, in.L);
       const Kernel kern = kernelOf<U>(in, m, j, hi);
-      const __m512 r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz));
       __m512 sc = zero;
       if (Tensile) {  // s_corr = sCorrK tensileCorrection(1, ...) for water neighbours
         const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
