@@ -84,8 +84,8 @@ struct RangeCache {
 };
 
 // the dense grid of buildNeighborLists: false (and nothing built) when the bounding box of x has
-// more than 8 cells a particle and more than 2^20 cells (4 MiB of starts), or no particles. The 2^20
-// keep a scene's domain dense once spray reaches its walls (Fig. 3(a): 75 x 56 x 75 cells for 25.6k
+// more than 8 cells a particle plus 2^20 cells (4 MiB of starts), or no particles. The 2^20 keep a
+// scene's domain dense once spray reaches its walls (Fig. 3(a): 75 x 56 x 75 cells for 25.6k
 // particles, 0.2 ms to sort; the hashed buckets took twice as long as the whole dense search)
 bool buildDenseCells(const std::vector<Vec3>& x, float cs, NeighborLists& lists) {
   const size_t n = x.size();
@@ -175,8 +175,8 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   const float cs = grid.cellSize;
   const bool parallel = static_cast<int64_t>(n) >= kParallelGrain;
   // a dense grid over the particles' bounding box (cells of the same size, x fastest) when it has no
-  // more than 8 cells a particle or 2^20 cells: then the three cells of a row around a particle are one range of
-  // the sorted entries, 9 ranges of about 3 cells instead of 27 of one. Else the hashed grid's buckets
+  // more than 8 cells a particle plus 2^20: then the three cells of a row around a particle are one range
+  // of the sorted entries, 9 ranges of about 3 cells instead of 27 of one. Else the hashed grid's buckets
   const bool dense = buildDenseCells(x, cs, lists);
   lists.dense = dense;
   const uint32_t* entries = dense ? lists.denseEntries.data() : grid.cellEntries.data();
