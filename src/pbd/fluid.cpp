@@ -277,8 +277,9 @@ inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t 
       if (Tensile) {  // s_corr = sCorrK tensileCorrection(1, ...) for water neighbours
         const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
         const __mmask16 water = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase));
-        const __m512 q = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero), mul(kern.h2, set(in.oneMinusDq2)));
-        __m512 base = mul(mul(q, q), q), power = set(1.0f);
+        const __m512 ratio = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero),
+                                           mul(kern.h2, set(in.oneMinusDq2)));
+        __m512 base = mul(mul(ratio, ratio), ratio), power = set(1.0f);
         for (int bit = 0; bit < 6; ++bit) {
           if ((in.tensileN >> bit) & 1) power = mul(power, base);
           base = mul(base, base);
