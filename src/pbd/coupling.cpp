@@ -358,13 +358,16 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
       conflict |= s.candidateSide[c] != sheetSide;
     }
     if (!conflict) return;
-    // the nearest face q starts over knows its side better than the smoothed normal at the nearest
-    // particle (q within a millimetre of a curved sheet: the two can disagree, and the triangles beside
-    // q then pushed it through the face under it)
+    // a face q starts over within half the thickness knows its side better than the smoothed normal at
+    // the nearest particle (q within a millimetre of a tightly curved sheet: the tangent plane there
+    // passes on the other side of q, and the triangles beside q then pushed it through the face under
+    // it). Farther off, the face may be the other layer of a fold, whose side is not this layer's
     float nearest = std::numeric_limits<float>::max(), side = sheetSide;
     for (uint32_t c = c0; c < c1; ++c) {
-      const float dist = overFaceDistance(model, p, s, s.candidates[c], xq0);
-      if (std::fabs(dist) < nearest) nearest = std::fabs(dist), side = dist >= 0.0f ? 1.0f : -1.0f;
+      const uint32_t tri = s.candidates[c];
+      const float dist = overFaceDistance(model, p, s, tri, xq0);
+      const float close = 0.5f * model.pieces[clothPiece(p.phase[model.triangles[tri][0]])].material.thickness;
+      if (std::fabs(dist) < std::min(nearest, close)) nearest = std::fabs(dist), side = dist >= 0.0f ? 1.0f : -1.0f;
     }
     if (side == sheetSide) return;
     for (uint32_t c = c0; c < c1; ++c) s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, side);

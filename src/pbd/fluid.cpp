@@ -127,6 +127,13 @@ struct PairInputs {
   float invRho0;
   float sCorrK, oneMinusDq2;
   int tensileN;
+  // the pair cache (FluidScratch::pairG*): the lambda pass writes m_j sf_ij r_ij and |r_ij|^2 of list
+  // entry k at [k - cacheBase], the correction pass of the same iteration reads them; null when off
+  float* cacheGx = nullptr;
+  float* cacheGy = nullptr;
+  float* cacheGz = nullptr;
+  float* cacheR2 = nullptr;
+  uint32_t cacheBase = 0;
 };
 
 #if defined(__AVX512F__)
@@ -223,7 +230,15 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const Kernel kern = kernelOf<U>(in, m, j, hi);
       const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
       sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
-      const __m512 f = mul(mul(mj, set(in.invRho0)), spikyFactor(kern, r2, m));
+      const __m512 sf = spikyFactor(kern, r2, m), f = mul(mul(mj, set(in.invRho0)), sf);
+      if (in.cacheGx) {  // m_j sf r for the correction pass
+        const __m512 g = mul(mj, sf);
+        const uint32_t at = k - in.cacheBase;
+        _mm512_mask_storeu_ps(in.cacheGx + at, m, mul(g, rx));
+        _mm512_mask_storeu_ps(in.cacheGy + at, m, mul(g, ry));
+        _mm512_mask_storeu_ps(in.cacheGz + at, m, mul(g, rz));
+        _mm512_mask_storeu_ps(in.cacheR2 + at, m, r2);
+      }
       sGx = add(sGx, mul(f, rx));
       sGy = add(sGy, mul(f, ry));
       sGz = add(sGz, mul(f, rz));
@@ -242,7 +257,12 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
     const float kh = U ? in.hU : 0.5f * (hi + in.H[j]), kinv = U ? in.invU : 1.0f / kh;
     const float mj = in.M[j];
     r += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
-    const float f = mj * in.invRho0 * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
+    const float sf = spikyFactorOf(kh, spikyCoefOf(kinv), r2), f = mj * in.invRho0 * sf;
+    if (in.cacheGx) {
+      const float g = mj * sf;
+      const uint32_t at = k - in.cacheBase;
+      in.cacheGx[at] = g * rx, in.cacheGy[at] = g * ry, in.cacheGz[at] = g * rz, in.cacheR2[at] = r2;
+    }
     gx += f * rx;
     gy += f * ry;
     gz += f * rz;
@@ -253,10 +273,66 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
   sumOthers = so;
 }
 
+// the correction pass from the pair cache: sum_j (lambda_i + lambda_j + s_corr) (m_j sf_ij r_ij), the
+// pairs' geometry as the lambda pass of this iteration left it (the positions have not moved since)
+template <bool U, bool Tensile>
+inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
+  const float hi = in.H[i], li = in.L[i];
+  float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+  uint32_t k = k0;
+#if defined(__AVX512F__)
+  if (k1 - k0 >= kSimdMinPairs) {
+    using namespace v16;
+    const __m512 vli = set(li), zero = _mm512_setzero_ps();
+    __m512 sx = zero, sy = zero, sz = zero;
+    for (; k < k1; k += 16) {
+      const __mmask16 m = lanes(k, k1);
+      const uint32_t at = k - in.cacheBase;
+      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k);
+      const __m512 lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
+      __m512 sc = zero;
+      if (Tensile) {  // s_corr = sCorrK tensileCorrection(1, ...) for water neighbours
+        const Kernel kern = kernelOf<U>(in, m, j, hi);
+        const __m512 r2 = _mm512_maskz_loadu_ps(m, in.cacheR2 + at);
+        const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
+        const __mmask16 water = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase));
+        const __m512 ratio = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero),
+                                           mul(kern.h2, set(in.oneMinusDq2)));
+        __m512 base = mul(mul(ratio, ratio), ratio), power = set(1.0f);
+        for (int bit = 0; bit < 6; ++bit) {
+          if ((in.tensileN >> bit) & 1) power = mul(power, base);
+          base = mul(base, base);
+        }
+        sc = _mm512_maskz_mul_ps(water, set(in.sCorrK), mul(set(-1.0f), power));
+      }
+      const __m512 lam = add(add(vli, lj), sc);
+      sx = add(sx, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGx + at)));
+      sy = add(sy, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGy + at)));
+      sz = add(sz, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGz + at)));
+    }
+    dx = sum(sx), dy = sum(sy), dz = sum(sz);
+    k = k1;
+  }
+#endif
+  for (; k < k1; ++k) {
+    const uint32_t j = in.index[k], at = k - in.cacheBase;
+    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]);
+    const float sc = Tensile && in.phase[j] == kWaterPhase
+                         ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, in.cacheR2[at], kh * kh)
+                         : 0.0f;
+    const float lam = li + in.L[j] + sc;
+    dx += lam * in.cacheGx[at];
+    dy += lam * in.cacheGy[at];
+    dz += lam * in.cacheGz[at];
+  }
+  return Vec3(dx, dy, dz);
+}
+
 // correction pass of water particle i: sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (a cloth
 // neighbour has lambda 0 and no s_corr)
 template <bool U, bool Tensile>
 inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
+  if (in.cacheGx) return cachedCorrectionSum<U, Tensile>(in, i, k0, k1);
   const float* X = in.X;
   const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = in.H[i], li = in.L[i];
   float dx = 0.0f, dy = 0.0f, dz = 0.0f;
@@ -407,8 +483,18 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const float* L = s.lambda.data();
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
-  const PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
-                      nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
+  PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
+                nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
+  // the pair cache: 16 bytes a pair of the water's lists, when that fits s.pairCacheLimit (not the
+  // 1M-particle block: its memory target). It spares the correction pass four gathers, a square root
+  // and a division a pair
+  const size_t waterPairs = nb.start[n] - nb.start[static_cast<size_t>(nc)];
+  if (waterPairs * 4 * sizeof(float) <= s.pairCacheLimit) {
+    for (std::vector<float>* v : {&s.pairGx, &s.pairGy, &s.pairGz, &s.pairR2}) v->resize(waterPairs);
+    in.cacheGx = s.pairGx.data(), in.cacheGy = s.pairGy.data(), in.cacheGz = s.pairGz.data();
+    in.cacheR2 = s.pairR2.data();
+    in.cacheBase = nb.start[static_cast<size_t>(nc)];
+  }
   const auto solve = [&](auto uniform, auto tensile) {
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (int it = 0; it < iterations; ++it) {

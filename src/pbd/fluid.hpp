@@ -24,6 +24,11 @@ struct FluidScratch {
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
   std::vector<float> wallClear;    // m, per water particle: its distance to the nearest part at wallFrom
   std::vector<Vec3> wallFrom;      // m, where each water particle was when wallClear was measured
+  // per entry of the water particles' neighbour lists, written by the lambda pass and read by the
+  // correction pass of the same iteration: m_j sf_ij r_ij (kg m, the spiky gradient's factor sf) and
+  // |r_ij|^2 (m^2); used only while the four arrays take at most pairCacheLimit bytes
+  std::vector<float> pairGx, pairGy, pairGz, pairR2;
+  size_t pairCacheLimit = size_t(256) << 20;
 };
 
 // Akinci volume of each cloth particle, V_b = 1 / sum_k W_bk over the same piece (Eq. 10), and

@@ -191,7 +191,7 @@ Scene squeezedWaterOnCloth(const std::string& tensileK) {
   return scene;
 }
 
-void expectSolverMatchesReference(Scene& scene) {
+void expectSolverMatchesReference(Scene& scene, size_t pairCacheLimit) {
   const Model& model = scene.model;
   Particles& p = scene.state.particles;
   NeighborGrid grid;
@@ -199,6 +199,7 @@ void expectSolverMatchesReference(Scene& scene) {
   buildGrid(p.xPred, maxSupportRadius(p), grid);
   buildNeighborLists(p.xPred, p.radius, grid, nb, static_cast<uint32_t>(model.numCloth));
   FluidScratch s;
+  s.pairCacheLimit = pairCacheLimit;
   computeBoundaryPsi(model, p, nb, s);
   const std::vector<Vec3> before = p.xPred;
   solveFluid(model, {}, p, nb, s, 1);
@@ -222,19 +223,23 @@ void expectSolverMatchesReference(Scene& scene) {
 
 TEST(Fluid, SolverPassMatchesPairByPairReference) {
   // the solver's pair sums (16 neighbours at a time with AVX-512, scalar for short lists) against a
-  // plain double-precision loop: equal radii, the artificial pressure, and mixed radii
-  Scene equal = squeezedWaterOnCloth("0");
-  expectSolverMatchesReference(equal);
-  Scene tensile = squeezedWaterOnCloth("0.1");
-  expectSolverMatchesReference(tensile);
-  Scene mixed = squeezedWaterOnCloth("0.1");
-  Particles& p = mixed.state.particles;
-  for (size_t i = static_cast<size_t>(mixed.model.numCloth); i < p.size(); i += 2) {  // every other one shrunk
-    p.mass[i] *= 0.5f;
-    p.invMass[i] = 1.0f / p.mass[i];
-    p.radius[i] *= std::cbrt(0.5f);
+  // plain double-precision loop: equal radii, the artificial pressure, and mixed radii; with the pair
+  // cache of the correction pass (the default here) and without it (a large scene's path)
+  for (const size_t limit : {FluidScratch().pairCacheLimit, size_t(0)}) {
+    SCOPED_TRACE(limit ? "pair cache" : "no pair cache");
+    Scene equal = squeezedWaterOnCloth("0");
+    expectSolverMatchesReference(equal, limit);
+    Scene tensile = squeezedWaterOnCloth("0.1");
+    expectSolverMatchesReference(tensile, limit);
+    Scene mixed = squeezedWaterOnCloth("0.1");
+    Particles& p = mixed.state.particles;
+    for (size_t i = static_cast<size_t>(mixed.model.numCloth); i < p.size(); i += 2) {  // every other one shrunk
+      p.mass[i] *= 0.5f;
+      p.invMass[i] = 1.0f / p.mass[i];
+      p.radius[i] *= std::cbrt(0.5f);
+    }
+    expectSolverMatchesReference(mixed, limit);
   }
-  expectSolverMatchesReference(mixed);
 }
 
 TEST(Fluid, XsphMatchesPairByPairReference) {
