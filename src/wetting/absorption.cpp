@@ -39,6 +39,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
   const Vec3 g = gravityDirection(model);
   const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
   const float minMass = w.minMassFraction * m0;
+  const uint32_t cloth = static_cast<uint32_t>(nc);  // water lists: their cloth part holds the absorbers
 
   // what each cloth particle can still take, kg: (S^MAX - S_i) V_i / c, the buffer counting as held
   s.capacity.resize(static_cast<size_t>(nc));
@@ -60,7 +61,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     const int64_t j = nc + k;
     if (!absorbs(j)) return;
     float total = 0.0f;
-    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+    for (uint32_t e = nb.start[j], end = nb.clothEnd(j, cloth); e < end; ++e) {  // the cloth part
       const int64_t i = nb.index[e];
       if (i < nc) total += request(i, j);
     }
@@ -84,7 +85,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     const int64_t j = nc + k;
     if (s.waterScale[j] <= 0.0f) return;
     float loss = 0.0f;
-    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+    for (uint32_t e = nb.start[j], end = nb.clothEnd(j, cloth); e < end; ++e) {  // the cloth part
       const int64_t i = nb.index[e];
       if (i < nc) loss += s.clothScale[i] * s.waterScale[j] * request(i, j);
     }
@@ -111,7 +112,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     whole += s.keep[j] ? 0 : 1;
     double shares = 0.0;
     int64_t last = -1;
-    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+    for (uint32_t e = nb.start[j], end = nb.clothEnd(j, cloth); e < end; ++e) {  // the cloth part
       const int64_t i = nb.index[e];
       if (i >= nc) continue;
       const double t = static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j);
@@ -122,7 +123,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     }
     if (last < 0) continue;  // unreachable: a loss needs an absorber
     double given = 0.0;
-    for (uint32_t e = nb.start[j]; e < nb.start[j + 1]; ++e) {
+    for (uint32_t e = nb.start[j], end = nb.clothEnd(j, cloth); e < end; ++e) {  // the cloth part
       const int64_t i = nb.index[e];
       if (i >= nc) continue;
       const double t = static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j);
