@@ -211,6 +211,13 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
       }
     }
     uint32_t ncl = 0, nwa = 0;
+    // locals, not the closure's references: the vector stores below may alias anything, and GCC would
+    // load every pointer again after each of them
+    const float* const PX = px;
+    const float* const PY = py;
+    const float* const PZ = pz;
+    const float* const PH = ph;
+    const uint32_t* const E = entries;
     for (int r = 0; r < count; ++r) {
       const uint32_t k0 = ranges[r][0], k1 = ranges[r][1];
       if (ncl + (k1 - k0) + 16 > cl.size()) cl.resize(2 * (ncl + (k1 - k0) + 16));  // + 16: whole-vector stores
@@ -226,13 +233,13 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
       const __m512i self = _mm512_set1_epi32(static_cast<int>(i)), split = _mm512_set1_epi32(static_cast<int>(firstWater));
       for (; k < k1; k += 16) {
         const __mmask16 lanes = k1 - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (k1 - k)) - 1u);
-        const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, px + k));
-        const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, py + k));
-        const __m512 dz = _mm512_sub_ps(vz, _mm512_maskz_loadu_ps(lanes, pz + k));
-        const __m512 h = _mm512_mul_ps(half, _mm512_add_ps(vh, _mm512_maskz_loadu_ps(lanes, ph + k)));
+        const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, PX + k));
+        const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, PY + k));
+        const __m512 dz = _mm512_sub_ps(vz, _mm512_maskz_loadu_ps(lanes, PZ + k));
+        const __m512 h = _mm512_mul_ps(half, _mm512_add_ps(vh, _mm512_maskz_loadu_ps(lanes, PH + k)));
         // (dx^2 + dy^2) + dz^2, rounded as the scalar expression (no FMA)
         const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
-        const __m512i j = _mm512_maskz_loadu_epi32(lanes, entries + k);
+        const __m512i j = _mm512_maskz_loadu_epi32(lanes, E + k);
         const __mmask16 in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(h, h), _CMP_LT_OQ) &
                              _mm512_cmpneq_epi32_mask(j, self);
         const __mmask16 isCloth = _mm512_cmplt_epu32_mask(j, split);
@@ -246,9 +253,9 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
       }
 #else
       for (; k < k1; ++k) {
-        const float dx = xi - px[k], dy = yi - py[k], dz = zi - pz[k];
-        const float h = 0.5f * (hi + ph[k]);
-        const uint32_t j = entries[k];
+        const float dx = xi - PX[k], dy = yi - PY[k], dz = zi - PZ[k];
+        const float h = 0.5f * (hi + PH[k]);
+        const uint32_t j = E[k];
         const uint32_t in = (dx * dx + dy * dy + dz * dz < h * h) & (j != static_cast<uint32_t>(i));
         const uint32_t isCloth = j < firstWater;
         pc[ncl] = j;
