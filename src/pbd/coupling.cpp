@@ -167,6 +167,13 @@ float overFaceDistance(const Model& model, const Particles& p, const CouplingScr
 template <class Take>
 void walkNearPath(const ClothBoxGrid& grid, const Vec3& a, const Vec3& ab, float reachQ, float reach, Take&& take) {
   const Vec3 lo = grid.origin, hi = grid.origin + grid.dims.cast<float>() * grid.cell;
+  // locals: take() writes memory, after which GCC would load the grid's pointers again
+  const float* const PX = grid.px.data();
+  const float* const PY = grid.py.data();
+  const float* const PZ = grid.pz.data();
+  const float* const PR = grid.pr.data();
+  const uint32_t* const entry = grid.entry.data();
+  const uint32_t* const cellStart = grid.cellStart.data();
   const float len2 = ab.squaredNorm();
   const float invLen2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;  // a still particle: its start point
   // the path in pieces no longer than a cell; each piece's box of cells, row by row (one range each)
@@ -178,7 +185,7 @@ void walkNearPath(const ClothBoxGrid& grid, const Vec3& a, const Vec3& ab, float
     const Eigen::Vector3i c0 = grid.clampedCell(boxLo), c1 = grid.clampedCell(boxHi);
     for (int cz = c0.z(); cz <= c1.z(); ++cz)
       for (int cy = c0.y(); cy <= c1.y(); ++cy) {
-        const uint32_t e0 = grid.cellStart[grid.index(c0.x(), cy, cz)], e1 = grid.cellStart[grid.index(c1.x(), cy, cz) + 1];
+        const uint32_t e0 = cellStart[grid.index(c0.x(), cy, cz)], e1 = cellStart[grid.index(c1.x(), cy, cz) + 1];
         uint32_t e = e0;
 #if defined(__AVX512F__)
         // 16 slots of the row at a time; the few within reach are taken in slot order
@@ -188,25 +195,25 @@ void walkNearPath(const ClothBoxGrid& grid, const Vec3& a, const Vec3& ab, float
         const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
         for (; e < e1; e += 16) {
           const __mmask16 lanes = e1 - e >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (e1 - e)) - 1u);
-          const __m512 jx = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.px.data() + e), vax);
-          const __m512 jy = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.py.data() + e), vay);
-          const __m512 jz = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, grid.pz.data() + e), vaz);
+          const __m512 jx = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, PX + e), vax);
+          const __m512 jy = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, PY + e), vay);
+          const __m512 jz = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, PZ + e), vaz);
           const __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(jx, vbx), _mm512_mul_ps(jy, vby)), _mm512_mul_ps(jz, vbz));
           const __m512 u = minPs(maxPs(_mm512_mul_ps(dot, vinv), zero), one);
           const __m512 dx = _mm512_sub_ps(jx, _mm512_mul_ps(u, vbx)), dy = _mm512_sub_ps(jy, _mm512_mul_ps(u, vby)),
                        dz = _mm512_sub_ps(jz, _mm512_mul_ps(u, vbz));
           const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
-          const __m512 r = minPs(vreach, _mm512_maskz_loadu_ps(lanes, grid.pr.data() + e));
+          const __m512 r = minPs(vreach, _mm512_maskz_loadu_ps(lanes, PR + e));
           for (uint32_t in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(r, r), _CMP_LT_OQ); in; in &= in - 1)
-            take(grid.entry[e + static_cast<uint32_t>(__builtin_ctz(in))]);
+            take(entry[e + static_cast<uint32_t>(__builtin_ctz(in))]);
         }
 #endif
         for (; e < e1; ++e) {  // the same arithmetic, one slot at a time
-          const float jx = grid.px[e] - a.x(), jy = grid.py[e] - a.y(), jz = grid.pz[e] - a.z();
+          const float jx = PX[e] - a.x(), jy = PY[e] - a.y(), jz = PZ[e] - a.z();
           const float u = std::min(std::max((jx * ab.x() + jy * ab.y() + jz * ab.z()) * invLen2, 0.0f), 1.0f);
           const float dx = jx - u * ab.x(), dy = jy - u * ab.y(), dz = jz - u * ab.z();
-          const float r = std::min(reachQ, grid.pr[e]);
-          if (dx * dx + dy * dy + dz * dz < r * r) take(grid.entry[e]);
+          const float r = std::min(reachQ, PR[e]);
+          if (dx * dx + dy * dy + dz * dz < r * r) take(entry[e]);
         }
       }
   }
