@@ -194,6 +194,21 @@ inline __m512 spikyFactor(const Kernel& k, __m512 r2, __mmask16 m) {
   const __mmask16 in = _mm512_mask_cmp_ps_mask(m, len, k.h, _CMP_LT_OQ) & _mm512_cmp_ps_mask(len, set(1e-9f), _CMP_GT_OQ);
   return _mm512_maskz_div_ps(in, mul(mul(k.spiky, d), d), len);
 }
+// the artificial pressure s_corr = sCorrK tensileCorrection(1, ...) of the lanes' pairs, 0 for a cloth
+// neighbour and in masked lanes
+inline __m512 sCorr(const PairInputs& in, const Kernel& kern, __m512 r2, __mmask16 m, __m512i j) {
+  const __m512 zero = _mm512_setzero_ps();
+  const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
+  const __mmask16 water = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase));
+  const __m512 ratio = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero),
+                                     mul(kern.h2, set(in.oneMinusDq2)));
+  __m512 base = mul(mul(ratio, ratio), ratio), power = set(1.0f);
+  for (int bit = 0; bit < 6; ++bit) {
+    if ((in.tensileN >> bit) & 1) power = mul(power, base);
+    base = mul(base, base);
+  }
+  return _mm512_maskz_mul_ps(water, set(in.sCorrK), mul(set(-1.0f), power));
+}
 // the lanes' sum as a fixed tree (halves, quarters, pairs). The maskz forms here and in spikyFactor
 // (all lanes): GCC 12's headers draw -Wmaybe-uninitialized from the plain ones
 inline float sum(__m512 a) {
@@ -291,20 +306,7 @@ inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uin
       const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k);
       const __m512 lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
       __m512 sc = zero;
-      if (Tensile) {  // s_corr = sCorrK tensileCorrection(1, ...) for water neighbours
-        const Kernel kern = kernelOf<U>(in, m, j, hi);
-        const __m512 r2 = _mm512_maskz_loadu_ps(m, in.cacheR2 + at);
-        const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
-        const __mmask16 water = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase));
-        const __m512 ratio = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero),
-                                           mul(kern.h2, set(in.oneMinusDq2)));
-        __m512 base = mul(mul(ratio, ratio), ratio), power = set(1.0f);
-        for (int bit = 0; bit < 6; ++bit) {
-          if ((in.tensileN >> bit) & 1) power = mul(power, base);
-          base = mul(base, base);
-        }
-        sc = _mm512_maskz_mul_ps(water, set(in.sCorrK), mul(set(-1.0f), power));
-      }
+      if (Tensile) sc = sCorr(in, kernelOf<U>(in, m, j, hi), _mm512_maskz_loadu_ps(m, in.cacheR2 + at), m, j);
       const __m512 lam = add(add(vli, lj), sc);
       sx = add(sx, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGx + at)));
       sy = add(sy, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGy + at)));
@@ -350,18 +352,7 @@ inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t 
       const __m512 mj = gatherOf(q, in.M), lj = gatherOf(q, in.L);
       const Kernel kern = kernelOf<U>(in, m, j, hi);
       __m512 sc = zero;
-      if (Tensile) {  // s_corr = sCorrK tensileCorrection(1, ...) for water neighbours
-        const __m512i ph = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), m, j, in.phase, 4);
-        const __mmask16 water = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase));
-        const __m512 ratio = _mm512_div_ps(_mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero),
-                                           mul(kern.h2, set(in.oneMinusDq2)));
-        __m512 base = mul(mul(ratio, ratio), ratio), power = set(1.0f);
-        for (int bit = 0; bit < 6; ++bit) {
-          if ((in.tensileN >> bit) & 1) power = mul(power, base);
-          base = mul(base, base);
-        }
-        sc = _mm512_maskz_mul_ps(water, set(in.sCorrK), mul(set(-1.0f), power));
-      }
+      if (Tensile) sc = sCorr(in, kern, r2, m, j);
       const __m512 f = mul(mul(mj, add(add(vli, lj), sc)), spikyFactor(kern, r2, m));
       sx = add(sx, mul(f, rx));
       sy = add(sy, mul(f, ry));
