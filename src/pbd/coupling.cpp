@@ -355,10 +355,14 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   // across the sheet, so one side holds for every triangle of a layer (docs/models.md on Eq. 21)
   smoothStartNormals(model, p, s);
   s.candidateSide.resize(s.candidates.size());
+  s.particleSide.resize(static_cast<size_t>(nw));
+  s.searchedEnd.resize(static_cast<size_t>(nw));
   parallelFor(nw, [&](int64_t w) {
     const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
     const uint32_t c0 = s.candidateStart[static_cast<size_t>(w)], c1 = s.candidateStart[static_cast<size_t>(w) + 1];
     const float sheetSide = sheetSideOf(p, s, s.nearestCloth[static_cast<size_t>(w)], xq0);
+    s.particleSide[static_cast<size_t>(w)] = sheetSide;
+    s.searchedEnd[static_cast<size_t>(w)] = p.xPred[static_cast<size_t>(nc + w)];
     bool conflict = false;  // q starts over a face whose plane puts it on the other side
     for (uint32_t c = c0; c < c1; ++c) {
       s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, sheetSide);
@@ -377,9 +381,51 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
       if (std::fabs(dist) < std::min(nearest, close)) nearest = std::fabs(dist), side = dist >= 0.0f ? 1.0f : -1.0f;
     }
     if (side == sheetSide) return;
+    s.particleSide[static_cast<size_t>(w)] = side;
     for (uint32_t c = c0; c < c1; ++c) s.candidateSide[c] = candidateSideOf(model, p, s, s.candidates[c], xq0, side);
   });
 }
+
+namespace {
+
+// how far (m) the passes may carry a water particle from the path its candidates were searched along
+// before the rigid pass searches again: a triangle beside the searched path lies within about the
+// cloth's reach of it, and this is well inside that
+constexpr float kResearchDistance = 0.01f;
+
+// the rigid pass's second search (solveCoupling): the triangles around the cloth particles within reach
+// of q's path from its start to xq that are not among its candidates, given q's side, swept with
+// visit(tri, side, sweep) as the candidates were
+template <class Visit>
+void researchAndSweep(const Model& model, const Particles& p, const CouplingScratch& s, int64_t q, const Vec3& xq,
+                      float hCloth, Visit&& visit) {
+  const int64_t nc = model.numCloth;
+  const size_t w = static_cast<size_t>(q - nc);
+  const uint32_t c0 = s.candidateStart[w], c1 = s.candidateStart[w + 1];
+  const Vec3 a = p.x[q];
+  const float reachQ = 0.5f * (p.radius[q] + hCloth);
+  std::vector<uint32_t> found;
+  const auto take = [&](uint32_t j) {
+    for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
+      const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
+      if (s.startNormal[tri].isZero()) continue;
+      if (std::find(s.candidates.begin() + c0, s.candidates.begin() + c1, tri) != s.candidates.begin() + c1) continue;
+      if (std::find(found.begin(), found.end(), tri) == found.end()) found.push_back(tri);
+    }
+  };
+  walkNearPath(s.clothGrid, a, xq - a, reachQ, reachQ, take);
+  if (found.empty()) return;
+  const float side = s.particleSide[w];
+  std::vector<float> sides(found.size());
+  for (size_t k = 0; k < found.size(); ++k) sides[k] = candidateSideOf(model, p, s, found[k], a, side);
+  for (int sweep = 0; sweep < kRigidSweeps; ++sweep) {
+    bool moved = false;
+    for (size_t k = 0; k < found.size(); ++k) moved |= visit(found[k], sides[k], sweep == 0 ? 1 : sweep);
+    if (!moved) break;
+  }
+}
+
+}  // namespace
 
 uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, bool rigidCloth) {
   const int64_t nc = model.numCloth;
@@ -406,6 +452,10 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
     s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
                                      (p.xPred[f[2]] - c).squaredNorm()}));
   });
+
+  float hCloth = 0.0f;  // the largest cloth support radius, for the rigid pass's second search
+  if (rigidCloth)
+    for (int64_t j = 0; j < nc; ++j) hCloth = std::max(hCloth, p.radius[j]);
 
   // chunks of water particles go to whichever thread is free; each chunk records its contacts in its
   // own list, and the lists are summed in water order below, for any thread count
@@ -486,6 +536,17 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         bool moved = false;
         for (uint32_t c = c0; c < c1; ++c) moved |= visit(s.candidates[c], s.candidateSide[c], sweep);
         if (!moved) break;
+      }
+      if (rigidCloth) {
+        // the passes pushed q along the normal of a triangle its path went through: over a curved sheet
+        // that can carry it centimetres past the path its candidates were searched along, beside
+        // triangles it never met. Then the triangles near its final path are searched and swept too
+        const size_t w = static_cast<size_t>(q - nc);
+        const Vec3 xq = p.xPred[q] + dq, a = xq0, ab = s.searchedEnd[w] - xq0;
+        const float len2 = ab.squaredNorm();
+        const float u = len2 > 0.0f ? std::clamp((xq - a).dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
+        if ((xq - (a + u * ab)).squaredNorm() > kResearchDistance * kResearchDistance)
+          researchAndSweep(model, p, s, q, xq, hCloth, visit);
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

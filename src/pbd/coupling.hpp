@@ -61,6 +61,8 @@ struct CouplingScratch {
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
   std::vector<float> candidateSide;          // +-1: the side of each candidate the particle came from
+  std::vector<float> particleSide;           // per water particle: the side given to candidates it does not start over
+  std::vector<Vec3> searchedEnd;             // per water particle: the end of the path its candidates were searched along
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep (0: degenerate)
   std::vector<Vec3> vertexNormal;            // per cloth particle: its triangles' area-weighted normals, summed
   std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
