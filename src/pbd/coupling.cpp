@@ -418,9 +418,10 @@ void researchAndSweep(const Model& model, const Particles& p, const CouplingScra
   const float side = s.particleSide[w];
   std::vector<float> sides(found.size());
   for (size_t k = 0; k < found.size(); ++k) sides[k] = candidateSideOf(model, p, s, found[k], a, side);
-  for (int sweep = 0; sweep < kRigidSweeps; ++sweep) {
+  // sweeps numbered from 1: visit then takes paths through a face only, as in the rigid pass's later sweeps
+  for (int sweep = 1; sweep <= kRigidSweeps; ++sweep) {
     bool moved = false;
-    for (size_t k = 0; k < found.size(); ++k) moved |= visit(found[k], sides[k], sweep == 0 ? 1 : sweep);
+    for (size_t k = 0; k < found.size(); ++k) moved |= visit(found[k], sides[k], sweep);
     if (!moved) break;
   }
 }
