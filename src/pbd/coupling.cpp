@@ -141,25 +141,32 @@ float sheetSideOf(const Particles& p, const CouplingScratch& s, int32_t nearest,
   return nearest < 0 || (xq0 - p.x[nearest]).dot(s.sheetNormal[nearest]) >= 0.0f ? 1.0f : -1.0f;
 }
 
+// q's signed distance to the start plane of triangle tri
+float startPlaneDistance(const Model& model, const Particles& p, const CouplingScratch& s, uint32_t tri, const Vec3& xq0) {
+  return (xq0 - p.x[model.triangles[tri][0]]).dot(s.startNormal[tri]);
+}
+
+// whether q, at distance dist from tri's start plane, projects onto the triangle's face
+bool startsOverFace(const Model& model, const Particles& p, const CouplingScratch& s, uint32_t tri, const Vec3& xq0,
+                    float dist) {
+  const auto& f = model.triangles[tri];
+  const Vec3 over = planeBarycentric(xq0 - dist * s.startNormal[tri], p.x[f[0]], p.x[f[1]], p.x[f[2]]);
+  return over.minCoeff() >= -kFaceTolerance;
+}
+
 // Eq. 21's sign for triangle tri: its own start plane where q starts over its face, else the sheet's side
 float candidateSideOf(const Model& model, const Particles& p, const CouplingScratch& s, uint32_t tri, const Vec3& xq0,
                       float sheetSide) {
-  const auto& f = model.triangles[tri];
-  const Vec3& n0 = s.startNormal[tri];
-  const float dist = (xq0 - p.x[f[0]]).dot(n0);
+  const float dist = startPlaneDistance(model, p, s, tri, xq0);
   const float own = dist >= 0.0f ? 1.0f : -1.0f;
   if (own == sheetSide) return own;  // most candidates: both rules agree, no need to know where q projects
-  const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
-  return over.minCoeff() >= -kFaceTolerance ? own : sheetSide;
+  return startsOverFace(model, p, s, tri, xq0, dist) ? own : sheetSide;
 }
 
 // q's signed distance to the start plane of triangle tri when q starts over its face, else +infinity
 float overFaceDistance(const Model& model, const Particles& p, const CouplingScratch& s, uint32_t tri, const Vec3& xq0) {
-  const auto& f = model.triangles[tri];
-  const Vec3& n0 = s.startNormal[tri];
-  const float dist = (xq0 - p.x[f[0]]).dot(n0);
-  const Vec3 over = planeBarycentric(xq0 - dist * n0, p.x[f[0]], p.x[f[1]], p.x[f[2]]);
-  return over.minCoeff() >= -kFaceTolerance ? dist : std::numeric_limits<float>::infinity();
+  const float dist = startPlaneDistance(model, p, s, tri, xq0);
+  return startsOverFace(model, p, s, tri, xq0, dist) ? dist : std::numeric_limits<float>::infinity();
 }
 
 // calls take(j) for every cloth particle j of the grid within min(reachQ, its own reach) of the path
@@ -267,6 +274,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   // bound (h_q + h_cloth) / 2
   float hCloth = 0.0f;
   for (int64_t j = 0; j < nc; ++j) hCloth = std::max(hCloth, p.radius[j]);
+  s.clothRadius = hCloth;
   s.vertexReach.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t j) {
     float shift2 = (p.xPred[j] - p.x[j]).squaredNorm(), edge2 = 0.0f;
@@ -398,12 +406,12 @@ constexpr float kResearchDistance = 0.01f;
 // visit(tri, side, sweep) as the candidates were
 template <class Visit>
 void researchAndSweep(const Model& model, const Particles& p, const CouplingScratch& s, int64_t q, const Vec3& xq,
-                      float hCloth, Visit&& visit) {
+                      Visit&& visit) {
   const int64_t nc = model.numCloth;
   const size_t w = static_cast<size_t>(q - nc);
   const uint32_t c0 = s.candidateStart[w], c1 = s.candidateStart[w + 1];
   const Vec3 a = p.x[q];
-  const float reachQ = 0.5f * (p.radius[q] + hCloth);
+  const float reachQ = 0.5f * (p.radius[q] + s.clothRadius);  // as in findCouplingCandidates
   std::vector<uint32_t> found;
   const auto take = [&](uint32_t j) {
     for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
@@ -453,10 +461,6 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
     s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
                                      (p.xPred[f[2]] - c).squaredNorm()}));
   });
-
-  float hCloth = 0.0f;  // the largest cloth support radius, for the rigid pass's second search
-  if (rigidCloth)
-    for (int64_t j = 0; j < nc; ++j) hCloth = std::max(hCloth, p.radius[j]);
 
   // chunks of water particles go to whichever thread is free; each chunk records its contacts in its
   // own list, and the lists are summed in water order below, for any thread count
@@ -547,7 +551,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const float len2 = ab.squaredNorm();
         const float u = len2 > 0.0f ? std::clamp((xq - a).dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
         if ((xq - (a + u * ab)).squaredNorm() > kResearchDistance * kResearchDistance)
-          researchAndSweep(model, p, s, q, xq, hCloth, visit);
+          researchAndSweep(model, p, s, q, xq, visit);
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

@@ -63,6 +63,7 @@ struct CouplingScratch {
   std::vector<float> candidateSide;          // +-1: the side of each candidate the particle came from
   std::vector<float> particleSide;           // per water particle: the side given to candidates it does not start over
   std::vector<Vec3> searchedEnd;             // per water particle: the end of the path its candidates were searched along
+  float clothRadius = 0.0f;                  // m, the largest cloth support radius when the candidates were searched
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep (0: degenerate)
   std::vector<Vec3> vertexNormal;            // per cloth particle: its triangles' area-weighted normals, summed
   std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
