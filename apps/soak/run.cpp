@@ -285,6 +285,8 @@ int validateCommand(const ValidateOptions& o) {
   std::printf("  dt:          %g s, %d substeps\n", static_cast<double>(s.dt), s.substeps);
   std::printf("  iterations:  fluid %d, cloth %d, coupling %d\n", s.fluidIterations, s.clothIterations,
               s.couplingIterations);
+  if (m.wetting.enabled)
+    std::printf("  wetting:     Shao 2017, %s\n", m.wetting.everySubstep ? "after every substep" : "once a step (Algorithm 1)");
   std::printf("  output:      %d frames of %d steps (%g s simulated)\n", scene.output.frames,
               scene.output.stepsPerFrame,
               static_cast<double>(s.dt) * scene.output.stepsPerFrame * scene.output.frames);

@@ -54,6 +54,7 @@ struct WettingParams {
   float saturationMax = 0.4f;        // S^MAX: absorption stops here (Eq. 11)
   float initialSaturation = 0.0f;    // S of every cloth particle at load (Fig. 6 starts saturated)
   float rateStep = 0.015f;           // s, the step the rates kappa^a, kappa^s and the Eq. 18 transfer refer to
+  bool everySubstep = false;         // false: the wetting stages run once a step, with the step's dt (Algorithm 1)
   // absorption, Eq. 11
   bool absorption = true;
   float absorptionRate = 0.1f;       // kappa^a per rateStep
@@ -66,7 +67,7 @@ struct WettingParams {
   float diffusionGravityFactor = 0.4f;  // eta^d
   float smoothing = 0.8f;            // kappa^s per rateStep
   float epsilon = 1.0e11f;           // (m^2 kg)^-2, epsilon of Eq. 15 (in the units of |grad C|^2)
-  int diffusionIterations = 1;       // projections per substep
+  int diffusionIterations = 1;       // projections per wetting pass
   // emission, Eq. 18-19
   bool emission = true;
   float beta = 1.5f;                 // s^2/m, beta of Eq. 18

@@ -27,7 +27,9 @@ struct StageClock {
   }
 };
 
-void substep(const Model& model, State& state, Workspace& ws, float h, StepStats& stats) {
+// wetDt: the time the wetting stages cover, 0 to skip them (the step's dt after its last substep, or
+// the substep's h after each with wetting.everySubstep)
+void substep(const Model& model, State& state, Workspace& ws, float h, float wetDt, StepStats& stats) {
   Particles& p = state.particles;
   StageTimes& ms = stats.ms;
   StageClock clock;
@@ -64,13 +66,15 @@ void substep(const Model& model, State& state, Workspace& ws, float h, StepStats
   stats.meanDensityRatio = meanDensityRatio(model, p, ws.fluid);
   commitPositions(p);                                                               // x = x*
   ms.velocities += clock.lap();
-  updatePorosity(model, state, ws.neighbors, ws.wetting);                           // V_i, S_i, wet mass (Eq. 10)
-  absorbWater(model, state, ws.neighbors, ws.wetting, h);                           // water soaks in (Eq. 11)
-  diffuseWater(model, state, ws.neighbors, ws.wetting, h);                          // spreads in the cloth (Eq. 12-17)
-  emitExcessWater(model, state, ws.neighbors, ws.grid, ws.wetting, h);              // excess runs down, drips (Eq. 18)
-  applyDripAttraction(model, state, ws.neighbors, ws.wetting, h);                   // cloth holds its drips (Eq. 19)
-  applySticking(model, state, ws.neighbors, ws.wetting, h);                         // wet cloth sticks (Eq. 20)
-  finishWetting(model, state, ws.wetting);                                          // absorbed water leaves; ledger
+  if (wetDt > 0.0f) {
+    updatePorosity(model, state, ws.neighbors, ws.wetting);                         // V_i, S_i, wet mass (Eq. 10)
+    absorbWater(model, state, ws.neighbors, ws.wetting, wetDt);                     // water soaks in (Eq. 11)
+    diffuseWater(model, state, ws.neighbors, ws.wetting, wetDt);                    // spreads in the cloth (Eq. 12-17)
+    emitExcessWater(model, state, ws.neighbors, ws.grid, ws.wetting, wetDt);        // excess runs down, drips (Eq. 18)
+    applyDripAttraction(model, state, ws.neighbors, ws.wetting, wetDt);             // cloth holds its drips (Eq. 19)
+    applySticking(model, state, ws.neighbors, ws.wetting, wetDt);                   // wet cloth sticks (Eq. 20)
+    finishWetting(model, state, ws.wetting);                                        // absorbed water leaves; ledger
+  }
   ms.wetting += clock.lap();
   stats.garment.dropsTaken += wetClothByContact(model, state, ws.neighbors, ws.garment, ws.keep, state.time + h);
   ms.garment += clock.lap();
@@ -90,7 +94,9 @@ void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& 
   const float h = dt / static_cast<float>(n);
   if (state.stepCount % kSortEverySteps == 0)                                       // water in cell order:
     sortParticlesByCell(state.particles, model.numCloth, model.water.supportRadius, ws.reorder);  // neighbours close in memory
-  for (int s = 0; s < n; ++s) substep(model, state, ws, h, stats);
+  // Algorithm 1's wetting once a step at its dt; the substeps refine the dynamics only (departure: docs/models.md)
+  const bool every = model.wetting.everySubstep;
+  for (int s = 0; s < n; ++s) substep(model, state, ws, h, every ? h : (s + 1 == n ? dt : 0.0f), stats);
   stats.substeps += n;
   stats.maxSpeed = maxSpeed(state.particles);
   ++state.stepCount;

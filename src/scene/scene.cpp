@@ -159,6 +159,7 @@ void readWetting(ObjectReader r, WettingParams& w) {
   w.enabled = r.boolean("enabled", r.present());
   w.c = r.number("c", d.c, Range::positive());
   w.rateStep = r.number("rateStep", d.rateStep, Range::positive());
+  w.everySubstep = r.boolean("everySubstep", d.everySubstep);
   ObjectReader s = r.object("saturation");
   const Range fraction{0.0, 1.0, true, false};  // (0, 1]
   w.saturationSticky = s.number("sticky", d.saturationSticky, fraction);

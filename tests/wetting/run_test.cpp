@@ -112,6 +112,31 @@ TEST(WettingRun, MoreWaterPassesASaturatedClothThanADryOne) {
   EXPECT_GT(below[1], 500u) << "water held by a soaked cloth: the rigid coupling pass ignores Eq. 22";
 }
 
+TEST(WettingRun, WettingCoversTheStepOnceWhateverTheSubsteps) {
+  // a pinned vertical sheet starts above S^EW: emission fills the buffers and runs the excess down
+  // (Eq. 18), diffusion spreads it (Eq. 12-17). The cloth does not move, so with the wetting once a
+  // step at its dt (Algorithm 1) the held water and buffers after a step do not depend on the substeps;
+  // wetting.everySubstep runs the stages after each substep with the substep's dt instead
+  const auto run = [](int substeps, bool every) {
+    Scene s = sceneFromJson("{\"solver\": {\"dt\": 0.015, \"substeps\": " + std::to_string(substeps) +
+                            "}, \"cloth\": [" +
+                            rectangleJson("s", Vec3(0, 1, 0), 0.3f, 0.3f, 31, 31, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
+                            "], \"wetting\": {\"everySubstep\": " + (every ? "true" : "false") +
+                            ", \"c\": 5e-4, \"saturation\": {\"initial\": 0.38}}}");
+    runSteps(s, 1);
+    EXPECT_GT(sum(s.state.clothBuffer), 0.0);
+    std::vector<double> both = s.state.clothWater;
+    both.insert(both.end(), s.state.clothBuffer.begin(), s.state.clothBuffer.end());
+    return both;
+  };
+  const std::vector<double> one = run(1, false), four = run(4, false), everyFour = run(4, true);
+  EXPECT_TRUE(one == four);
+  EXPECT_FALSE(one == everyFour);
+  double most = 0.0, diff = 0.0;
+  for (size_t k = 0; k < one.size(); ++k) most = std::max(most, one[k]), diff = std::max(diff, std::fabs(one[k] - everyFour[k]));
+  EXPECT_LT(diff, 0.1 * most);  // the per-step rates are converted to the substep (wetting.rateStep)
+}
+
 TEST(WettingRun, CliWritesSaturationAndColours) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("soak_wetting_cli_" + std::to_string(getpid()));
