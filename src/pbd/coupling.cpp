@@ -301,6 +301,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   const int64_t chunks = (nw + kWaterChunk - 1) / kWaterChunk;
   s.chunkCandidates.resize(static_cast<size_t>(chunks));
   std::vector<size_t> offset(static_cast<size_t>(chunks) + 1, 0);
+  s.triangleActive.assign(nTri, 0);
+  uint8_t* const active = s.triangleActive.data();
   // chunks of water particles go to whichever thread is free (the water near the sheet is not spread
   // evenly over the indices); each chunk fills its own list and the lists are joined in water order,
   // so the candidates do not depend on the thread count
@@ -332,7 +334,9 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
             const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
             if (seen[tri] == static_cast<uint32_t>(q)) continue;
             seen[tri] = static_cast<uint32_t>(q);
-            if (!s.startNormal[tri].isZero()) out.push_back(tri);  // a degenerate triangle has no side
+            if (s.startNormal[tri].isZero()) continue;  // a degenerate triangle has no side
+            out.push_back(tri);
+            __atomic_store_n(active + tri, uint8_t{1}, __ATOMIC_RELAXED);  // both threads may mark it
           }
         };
         walkNearPath(grid, a, ab, reachQ, reach, take);
@@ -355,6 +359,12 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
         s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(at);
     }
   }
+  // the triangles some particle has as a candidate: the passes need the planes of these only (in Fig. 1
+  // the 2.5k water particles near a 28k-triangle sheet have a few thousand)
+  // (marked as they are found, above)
+  s.activeTriangles.clear();
+  for (size_t t = 0; t < nTri; ++t)
+    if (active[t]) s.activeTriangles.push_back(static_cast<uint32_t>(t));
   // the side each water particle came from (Eq. 21's sign), the same for every pass. A triangle's own
   // plane decides only where q started over its face: the plane of a triangle beside q, on a ridge or
   // fold of a crumpled sheet, can pass on either side of q. Elsewhere q keeps the side of the sheet it
@@ -396,6 +406,15 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
 
 namespace {
 
+// triangle t's plane at the predicted positions (the cloth does not move during a pass)
+TrianglePlane trianglePlane(const Model& model, const Particles& p, const CouplingScratch& s, size_t t) {
+  const auto& f = model.triangles[t];
+  const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
+  const float l1 = n1.norm();
+  const Vec3 unit = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
+  return {unit, model.pieces[clothPiece(p.phase[f[0]])].material.thickness, p.xPred[f[0]], s.triangleStiffness[t]};
+}
+
 // how far (m) the passes may carry a water particle from the path its candidates were searched along
 // before the rigid pass searches again: a triangle beside the searched path lies within about the
 // cloth's reach of it, and this is well inside that
@@ -403,7 +422,7 @@ constexpr float kResearchDistance = 0.01f;
 
 // the rigid pass's second search (solveCoupling): the triangles around the cloth particles within reach
 // of q's path from its start to xq that are not among its candidates, given q's side, swept with
-// visit(tri, side, sweep) as the candidates were
+// visit(tri, plane, side, sweep) as the candidates were
 template <class Visit>
 void researchAndSweep(const Model& model, const Particles& p, const CouplingScratch& s, int64_t q, const Vec3& xq,
                       Visit&& visit) {
@@ -425,11 +444,15 @@ void researchAndSweep(const Model& model, const Particles& p, const CouplingScra
   if (found.empty()) return;
   const float side = s.particleSide[w];
   std::vector<float> sides(found.size());
-  for (size_t k = 0; k < found.size(); ++k) sides[k] = candidateSideOf(model, p, s, found[k], a, side);
+  std::vector<TrianglePlane> planes(found.size());  // not candidates: the pass computed no plane for most
+  for (size_t k = 0; k < found.size(); ++k) {
+    sides[k] = candidateSideOf(model, p, s, found[k], a, side);
+    planes[k] = trianglePlane(model, p, s, found[k]);
+  }
   // sweeps numbered from 1: visit then takes paths through a face only, as in the rigid pass's later sweeps
   for (int sweep = 1; sweep <= kRigidSweeps; ++sweep) {
     bool moved = false;
-    for (size_t k = 0; k < found.size(); ++k) moved |= visit(found[k], sides[k], sweep);
+    for (size_t k = 0; k < found.size(); ++k) moved |= visit(found[k], planes[k], sides[k], sweep);
     if (!moved) break;
   }
 }
@@ -446,16 +469,15 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   s.chunkContacts.resize(static_cast<size_t>(chunks));
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
-  // triangle normals once per pass, shared by every water particle that tests the triangle
+  // the candidates' planes once per pass, shared by every water particle that tests the triangle
   s.plane.resize(nTri);
   s.centroid.resize(nTri);
   s.reach.resize(nTri);
-  parallelFor(static_cast<int64_t>(nTri), [&](int64_t t) {
+  const uint32_t* activeTri = s.activeTriangles.data();
+  parallelFor(static_cast<int64_t>(s.activeTriangles.size()), [&](int64_t k) {
+    const size_t t = activeTri[k];
     const auto& f = model.triangles[t];
-    const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
-    const float l1 = n1.norm();
-    const Vec3 unit = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
-    s.plane[t] = {unit, model.pieces[clothPiece(p.phase[f[0]])].material.thickness, p.xPred[f[0]], s.triangleStiffness[t]};
+    s.plane[t] = trianglePlane(model, p, s, t);
     const Vec3 c = (p.xPred[f[0]] + p.xPred[f[1]] + p.xPred[f[2]]) / 3.0f;
     s.centroid[t] = c;
     s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
@@ -476,8 +498,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       const Vec3 xq0 = p.x[q];
       Vec3 dq = Vec3::Zero();
       // Eq. 21 for one candidate; true when it moved q
-      const auto visit = [&](uint32_t tri, float side, int sweep) {
-        const TrianglePlane& plane = s.plane[tri];
+      const auto visit = [&](uint32_t tri, const TrianglePlane& plane, float side, int sweep) {
         const Vec3& n1 = plane.normal;
         if (n1.isZero()) return false;
         if (rigidCloth && plane.stiffness < 1.0f) return false;  // Eq. 22: wet cloth lets water through
@@ -539,7 +560,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       // moves q: in a crumpled sheet the correction of one triangle can push q through another
       for (int sweep = 0, sweeps = rigidCloth ? kRigidSweeps : 1; sweep < sweeps; ++sweep) {
         bool moved = false;
-        for (uint32_t c = c0; c < c1; ++c) moved |= visit(s.candidates[c], s.candidateSide[c], sweep);
+        for (uint32_t c = c0; c < c1; ++c) moved |= visit(s.candidates[c], s.plane[s.candidates[c]], s.candidateSide[c], sweep);
         if (!moved) break;
       }
       if (rigidCloth) {
