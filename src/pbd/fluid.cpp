@@ -457,16 +457,10 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   // query the parts again only once the particle may have come within h of one. Factor 2 on the
   // distance moved: a trilinear mesh distance can change faster than the point moves
   if (!s.parts.empty()) {
-    s.wallClear.resize(static_cast<size_t>(nw));
-    s.wallFrom.resize(static_cast<size_t>(nw));
-    parallelFor(nw, [&](int64_t w) {
-      const Vec3& x = p.xPred[static_cast<size_t>(nc + w)];
-      float clear = std::numeric_limits<float>::max();
-      Vec3 normal;
-      for (const BoundaryPart& part : s.parts) clear = std::min(clear, colliderDistance(part.shape, part.pose, x, &normal));
-      s.wallClear[w] = clear;
-      s.wallFrom[w] = x;
-    });
+    s.wallClear.assign(static_cast<size_t>(nw), std::numeric_limits<float>::max());  // a lower bound is enough
+    s.wallFrom.assign(p.xPred.begin() + nc, p.xPred.end());
+    for (const BoundaryPart& part : s.parts)
+      colliderDistanceBounds(part.shape, part.pose, p.xPred[static_cast<size_t>(nc)].data(), nw, s.wallClear.data());
   }
   // the mass a neighbour lends the density: its own for water, the boundary mass Psi_b for cloth
   parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.massOrPsi[j] = j < nc ? s.psi[j] : p.mass[j]; });

@@ -51,7 +51,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
   solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // then stretch Eq. 8, bend Eq. 9
   clothSelfCollision(model, p, ws.neighbors, ws.cloth);
   ms.cloth += clock.lap();
-  projectColliders(model, ws.poses, p, h, ws.contactNormal);                         // rigid bodies, friction
+  projectColliders(model, ws.poses, p, h, ws.contactNormal, ws.colliderBound);      // rigid bodies, friction
   ms.colliders += clock.lap();
   updateCouplingStiffness(model, state, ws.coupling.triangleStiffness);             // Eq. 22: wetter cloth lets water through
   findCouplingCandidates(model, p, ws.coupling);                                    // triangles near each water particle's path

@@ -20,6 +20,7 @@ struct Workspace {
   NeighborLists neighbors;
   std::vector<ColliderPose> poses;      // collider poses at the end of the substep
   std::vector<Vec3> contactNormal;      // collider contact normal per particle, zero when none
+  std::vector<float> colliderBound;     // projectColliders' scratch: a lower bound of the distance to the colliders
   FluidScratch fluid;
   ClothScratch cloth;
   CouplingScratch coupling;

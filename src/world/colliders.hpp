@@ -25,6 +25,13 @@ ColliderPose colliderPose(const Collider& c, double t);
 // outward normal of the nearest surface in `normal` (world frame)
 float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal);
 
+// a lower bound of colliderDistance(c, pose, x_i) for the n points x_i = X[3i .. 3i+2], min-ed into
+// out[i] (out[i] = min(out[i], bound)): exact up to kDistanceBoundSlack for planes, spheres, capsules,
+// boxes and containers, in a vectorised loop without normals; a mesh collider gets its exact distance.
+// For skipping the points that cannot be within some distance of the collider
+constexpr float kDistanceBoundSlack = 1e-4f;  // m, covers the rounding of the matrix against the quaternion
+void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const float* X, int64_t n, float* out);
+
 // contact margin of a particle against colliders: water keeps half its spacing, cloth half its
 // thickness
 float contactMargin(const Model& model, int32_t phase);
@@ -32,6 +39,10 @@ float contactMargin(const Model& model, int32_t phase);
 // pushes every predicted position x* out of every collider (distance >= margin), removing the
 // fraction `friction` of the tangential motion relative to the collider over this substep.
 // contactNormal[i] is set to the world normal of the last contact of particle i, or zero.
+// distanceBound: scratch, a lower bound of each particle's distance to the nearest collider, so that
+// the particles far from every collider skip the exact test
+void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
+                      std::vector<Vec3>& contactNormal, std::vector<float>& distanceBound);
 void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal);
 
