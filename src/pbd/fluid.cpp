@@ -112,6 +112,25 @@ bool commonRadius(const std::vector<float>& radius, float& h) {
   return lo == radius.end() || *lo == *hi;
 }
 
+// when not every particle has the support radius h0 (partial absorption shrinks water, Eq. 11):
+// marks the particles with a pair whose radius is not h0, i.e. those of another radius and their
+// neighbours (the lists are symmetric: r < (h_i + h_j) / 2). Only these need the per-pair radius;
+// the others take the constant h0 (the same values: (h0 + h0) / 2 = h0). Returns whether any is marked
+bool markMixedRadius(const std::vector<float>& radius, const NeighborLists& nb, float h0, std::vector<uint8_t>& mixed) {
+  const size_t n = radius.size();
+  mixed.assign(n, 0);
+  std::vector<uint32_t> odd;
+  for (size_t i = 0; i < n; ++i)
+    if (radius[i] != h0) odd.push_back(static_cast<uint32_t>(i));
+  uint8_t* const m = mixed.data();
+  parallelFor(static_cast<int64_t>(odd.size()), [&](int64_t k) {
+    const uint32_t o = odd[static_cast<size_t>(k)];
+    __atomic_store_n(m + o, uint8_t{1}, __ATOMIC_RELAXED);  // two odd particles may mark a common neighbour
+    for (uint32_t e = nb.start[o]; e < nb.start[o + 1]; ++e) __atomic_store_n(m + nb.index[e], uint8_t{1}, __ATOMIC_RELAXED);
+  });
+  return !odd.empty();
+}
+
 // what the pair loops of one solver pass read: the positions, radii, masses (Psi for cloth), inverse
 // masses and lambdas of every particle, and the pass's constants
 struct PairInputs {
@@ -468,6 +487,9 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const float* L = s.lambda.data();
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
+  // mixed radii: the particles whose pairs all have h0 still take the constant-radius loops
+  if (!uniform) hU = wp.supportRadius, markMixedRadius(p.radius, nb, hU, s.mixedRadius);
+  const uint8_t* const mixed = s.mixedRadius.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
                 nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
   // the pair cache: 16 bytes a pair of the water's lists, when that fits s.pairCacheLimit (not the
@@ -489,7 +511,10 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         const float hi = H[i], mi = p.mass[i];
         float rho = 0.0f, sumOthers = 0.0f;  // sumOthers: sum over neighbours of w_k |grad_k C|^2
         Vec3 gradI;
-        densitySums<U>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
+        if (U || !mixed[i])
+          densitySums<true>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
+        else
+          densitySums<false>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
         rho += mi * poly6(0.0f, hi);
         // colliders as a continuous wall of boundary particles, skipped while the particle cannot have
         // come within h of one (exact: a part beyond h adds nothing)
@@ -509,7 +534,8 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       // a cloth neighbour has lambda 0 and no s_corr: Psi_b lambda_i grad W_ib
       parallelFor(nw, [&](int64_t w) {
         const size_t i = static_cast<size_t>(nc + w);
-        const Vec3 sumJ = correctionSum<U, Tensile>(in, i, nb.start[i], nb.start[i + 1]);
+        const Vec3 sumJ = U || !mixed[i] ? correctionSum<true, Tensile>(in, i, nb.start[i], nb.start[i + 1])
+                                         : correctionSum<false, Tensile>(in, i, nb.start[i], nb.start[i + 1]);
         s.delta[i] = (sumJ + rho0 * L[i] * s.delta[i]) * invRho0;  // + the wall gradient of the lambda pass
       });
       // cloth reaction (two-way): dx_b = -(w_b Psi_b / rho0) sum_i m_i lambda_i grad W_ib
@@ -517,7 +543,9 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         s.delta[b].setZero();
         if (p.invMass[b] == 0.0f) return;
         Vec3 sumI;
-        const int pushing = reactionSum<U>(in, static_cast<size_t>(b), nb.waterBegin(b, static_cast<uint32_t>(nc)), nb.start[b + 1], sumI);
+        const uint32_t k0 = nb.waterBegin(b, static_cast<uint32_t>(nc)), k1 = nb.start[b + 1];
+        const int pushing = U || !mixed[b] ? reactionSum<true>(in, static_cast<size_t>(b), k0, k1, sumI)
+                                           : reactionSum<false>(in, static_cast<size_t>(b), k0, k1, sumI);
         // averaged over the water particles pushing it (Jacobi averaging, Macklin et al. 2014 4.2):
         // the plain sum of ~30 corrections overshoots and makes the cloth a trampoline
         if (pushing) s.delta[b] = (p.invMass[b] * s.psi[b] / (rho0 * static_cast<float>(pushing))) * sumI;
@@ -551,35 +579,45 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   // in solveFluid), vorticity wanted
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
+  // as in solveFluid: only the particles with a pair of another radius take the per-pair radius
+  if (!uniform) hU = wp.supportRadius, markMixedRadius(p.radius, nb, hU, s.mixedRadius);
+  const uint8_t* const mixed = s.mixedRadius.data();
   const float invU = 1.0f / hU;
-  const auto xsph = [&](auto uniform, auto vortex) {
+  // one water particle's XSPH velocity (and vorticity)
+  const auto xsphOf = [&](auto uniform, auto vortex, size_t i) {
     constexpr bool U = decltype(uniform)::value, Vort = decltype(vortex)::value;
+    const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
+    const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
+    float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
+    for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
+      const uint32_t j = index[k];
+      const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+      const float r2 = rx * rx + ry * ry + rz * rz;
+      const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
+      // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
+      const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
+      const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
+      const float wgt = vol * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
+      bx += wgt * vx;
+      by += wgt * vy;
+      bz += wgt * vz;
+      if (Vort) {
+        const float f = vol * spikyFactorOf(kh, spikyCoefOf(kinv), r2);  // v_ij x (f r)
+        ox += f * (vy * rz - vz * ry);
+        oy += f * (vz * rx - vx * rz);
+        oz += f * (vx * ry - vy * rx);
+      }
+    }
+    if (Vort) s.vorticity[i] = Vec3(ox, oy, oz);
+    vNew[i] = Vec3(vxi, vyi, vzi) + wp.viscosity * Vec3(bx, by, bz);
+  };
+  const auto xsph = [&](auto uniform, auto vortex) {
     parallelFor(nw, [&](int64_t w) {
       const size_t i = static_cast<size_t>(nc + w);
-      const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
-      const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
-      float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
-      for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
-        const uint32_t j = index[k];
-        const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-        const float r2 = rx * rx + ry * ry + rz * rz;
-        const float kh = U ? hU : 0.5f * (hi + H[j]), kinv = U ? invU : 1.0f / kh;
-        // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
-        const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
-        const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
-        const float wgt = vol * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
-        bx += wgt * vx;
-        by += wgt * vy;
-        bz += wgt * vz;
-        if (Vort) {
-          const float f = vol * spikyFactorOf(kh, spikyCoefOf(kinv), r2);  // v_ij x (f r)
-          ox += f * (vy * rz - vz * ry);
-          oy += f * (vz * rx - vx * rz);
-          oz += f * (vx * ry - vy * rx);
-        }
-      }
-      if (Vort) s.vorticity[i] = Vec3(ox, oy, oz);
-      vNew[i] = Vec3(vxi, vyi, vzi) + wp.viscosity * Vec3(bx, by, bz);
+      if (decltype(uniform)::value || !mixed[i])
+        xsphOf(std::true_type{}, vortex, i);
+      else
+        xsphOf(std::false_type{}, vortex, i);
     });
   };
   withFlags(uniform, wp.vorticity > 0.0f, xsph);

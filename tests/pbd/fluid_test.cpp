@@ -239,20 +239,29 @@ TEST(Fluid, SolverPassMatchesPairByPairReference) {
       p.radius[i] *= std::cbrt(0.5f);
     }
     expectSolverMatchesReference(mixed, limit);
+    // one shrunk particle: it and its neighbours take the per-pair radius, the others the constant one
+    Scene one = squeezedWaterOnCloth("0.1");
+    Particles& q = one.state.particles;
+    const size_t mid = static_cast<size_t>(one.model.numCloth) + (q.size() - static_cast<size_t>(one.model.numCloth)) / 2;
+    q.mass[mid] *= 0.5f;
+    q.invMass[mid] = 1.0f / q.mass[mid];
+    q.radius[mid] *= std::cbrt(0.5f);
+    expectSolverMatchesReference(one, limit);
   }
 }
 
 TEST(Fluid, XsphMatchesPairByPairReference) {
   // the XSPH pass against a double-precision pair loop of Macklin 2013 Eq. 17 with soak's volume
-  // weights 2 m_j / (rho_i + rho_j), equal and mixed radii (scalar: 16-lane gathers were slower here)
-  for (const bool mixed : {false, true}) {
+  // weights 2 m_j / (rho_i + rho_j), equal radii, every other one shrunk, and one shrunk (its
+  // neighbours take the per-pair radius, the others the constant one); scalar: 16-lane gathers were slower
+  for (const int mixed : {0, 1, 2}) {
     Scene scene = squeezedWaterOnCloth("0");
     const Model& model = scene.model;
     Particles& p = scene.state.particles;
     const size_t nc = static_cast<size_t>(model.numCloth);
     for (size_t i = nc; i < p.size(); ++i) {
       p.v[i] = Vec3(std::sin(0.7f * float(i)), std::cos(1.3f * float(i)), std::sin(2.1f * float(i) + 1.0f));
-      if (mixed && i % 2 == 0) p.radius[i] *= 0.8f;
+      if ((mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2)) p.radius[i] *= 0.8f;
     }
     NeighborGrid grid;
     NeighborLists nb;
@@ -277,6 +286,6 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
       worst = std::max(worst, (p.v[i] - v0[i] - dv).norm());
     }
     EXPECT_GT(largest, 1e-3f);  // the velocities really differ between neighbours
-    EXPECT_LT(worst, 1e-4f * largest) << (mixed ? "mixed radii" : "equal radii");
+    EXPECT_LT(worst, 1e-4f * largest) << (mixed == 0 ? "equal radii" : mixed == 1 ? "mixed radii" : "one shrunk");
   }
 }
