@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace soak {
@@ -197,6 +198,48 @@ TEST(ColliderDistance, NormalsMatchFiniteDifferences) {
       EXPECT_NEAR((g - n).norm(), 0.0f, 5e-3f) << "shape " << static_cast<int>(c.shape) << " at " << p.transpose();
     }
     EXPECT_GT(checked, 300) << "shape " << static_cast<int>(c.shape);
+  }
+}
+
+TEST(ColliderDistance, VectorisedBoundsAreBelowTheExactDistanceAndClose) {
+  // colliderDistanceBounds (the skip test of the contacts and of the water's walls) against
+  // colliderDistance: never above it (a particle it skips cannot be in contact), at most the slack
+  // below it, for every shape in a rotated, moved frame; points on both sides of every surface, more
+  // than a chunk of them, and an out[] already lower stays
+  Collider box = makeCollider(ColliderShape::Box);
+  box.halfExtents = Vec3(0.4f, 0.25f, 0.3f);
+  Collider sphere = makeCollider(ColliderShape::Sphere);
+  sphere.radius = 0.35f;
+  Collider capsule = makeCollider(ColliderShape::Capsule);
+  capsule.radius = 0.15f;
+  capsule.halfHeight = 0.3f;
+  Collider container = makeCollider(ColliderShape::Container);
+  container.halfExtents = Vec3(0.4f, 0.3f, 0.35f);
+  container.wallThickness = 0.05f;
+  const std::vector<Collider> shapes = {makeCollider(ColliderShape::Plane), box, sphere, capsule, container};
+  const ColliderPose pose = staticPose(Vec3(0.1f, -0.2f, 0.3f), aroundAxis(0.7f, Vec3(1, 2, 3)));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-0.8f, 0.8f);
+  const int n = 1000;
+  std::vector<float> x(3 * n);
+  for (float& v : x) v = u(rng);
+  for (int i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) x[3 * i + a] += pose.translation[a];
+  for (const Collider& c : shapes) {
+    std::vector<float> out(n, std::numeric_limits<float>::max());
+    out[5] = -7.0f;  // already lower: kept
+    colliderDistanceBounds(c, pose, x.data(), n, out.data());
+    EXPECT_EQ(out[5], -7.0f);
+    int inside = 0;
+    for (int i = 0; i < n; ++i) {
+      if (i == 5) continue;
+      const float exact = dist(c, pose, Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]));
+      inside += exact < 0.0f;
+      EXPECT_LE(out[i], exact) << "shape " << static_cast<int>(c.shape) << " point " << i;
+      EXPECT_GE(out[i], exact - kDistanceBoundSlack - 1e-5f) << "shape " << static_cast<int>(c.shape) << " point " << i;
+    }
+    EXPECT_GT(inside, 10) << "shape " << static_cast<int>(c.shape);
+    EXPECT_LT(inside, n - 10) << "shape " << static_cast<int>(c.shape);
   }
 }
 
