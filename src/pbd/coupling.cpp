@@ -423,21 +423,25 @@ constexpr float kResearchDistance = 0.01f;
 // the rigid pass's second search (solveCoupling): the triangles around the cloth particles within reach
 // of q's path from its start to xq that are not among its candidates, given q's side, swept with
 // visit(tri, plane, side, sweep) as the candidates were
+// mark: this thread's marks (one per triangle), stamp: a value no earlier call of the thread left in them
 template <class Visit>
 void researchAndSweep(const Model& model, const Particles& p, const CouplingScratch& s, int64_t q, const Vec3& xq,
-                      Visit&& visit) {
+                      std::vector<uint32_t>& mark, uint32_t stamp, Visit&& visit) {
   const int64_t nc = model.numCloth;
   const size_t w = static_cast<size_t>(q - nc);
   const uint32_t c0 = s.candidateStart[w], c1 = s.candidateStart[w + 1];
   const Vec3 a = p.x[q];
   const float reachQ = 0.5f * (p.radius[q] + s.clothRadius);  // as in findCouplingCandidates
+  // the candidates and the triangles found so far carry the stamp (a folded sheet gives hundreds of
+  // candidates: a linear search of them per triangle was most of Fig. 6(b)'s coupling)
+  for (uint32_t c = c0; c < c1; ++c) mark[s.candidates[c]] = stamp;
   std::vector<uint32_t> found;
   const auto take = [&](uint32_t j) {
     for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
       const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
-      if (s.startNormal[tri].isZero()) continue;
-      if (std::find(s.candidates.begin() + c0, s.candidates.begin() + c1, tri) != s.candidates.begin() + c1) continue;
-      if (std::find(found.begin(), found.end(), tri) == found.end()) found.push_back(tri);
+      if (s.startNormal[tri].isZero() || mark[tri] == stamp) continue;
+      mark[tri] = stamp;
+      found.push_back(tri);
     }
   };
   walkNearPath(s.clothGrid, a, xq - a, reachQ, reachQ, take);
@@ -467,6 +471,8 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   const size_t nTri = model.triangles.size();
   const int64_t nw = n - nc, chunks = (nw + kWaterChunk - 1) / kWaterChunk;
   s.chunkContacts.resize(static_cast<size_t>(chunks));
+  s.researchMark.resize(static_cast<size_t>(nThreads));
+  s.researchCount.resize(static_cast<size_t>(nThreads), 0u);
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
   const int iters = std::max(1, model.solver.couplingIterations);
   // the candidates' planes once per pass, shared by every water particle that tests the triangle
@@ -571,8 +577,12 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const Vec3 xq = p.xPred[q] + dq, a = xq0, ab = s.searchedEnd[w] - xq0;
         const float len2 = ab.squaredNorm();
         const float u = len2 > 0.0f ? std::clamp((xq - a).dot(ab) / len2, 0.0f, 1.0f) : 0.0f;
-        if ((xq - (a + u * ab)).squaredNorm() > kResearchDistance * kResearchDistance)
-          researchAndSweep(model, p, s, q, xq, visit);
+        if ((xq - (a + u * ab)).squaredNorm() > kResearchDistance * kResearchDistance) {
+          const size_t t = static_cast<size_t>(omp_get_thread_num());
+          std::vector<uint32_t>& mark = s.researchMark[t];
+          if (mark.size() != nTri || s.researchCount[t] == ~0u) mark.assign(nTri, 0), s.researchCount[t] = 0;
+          researchAndSweep(model, p, s, q, xq, mark, ++s.researchCount[t], visit);
+        }
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }

@@ -53,6 +53,8 @@ struct CouplingScratch {
   std::vector<std::vector<CouplingContact>> chunkContacts;  // contacts of each chunk of water particles, in water order
   std::vector<std::vector<uint32_t>> seen;   // per thread: the water particle that last visited a triangle
   std::vector<std::vector<uint32_t>> seenCloth;  // per thread: the water particle that last tested a cloth particle
+  std::vector<std::vector<uint32_t>> researchMark;  // per thread: the rigid pass's second search that last met a triangle
+  std::vector<uint32_t> researchCount;       // per thread: second searches so far (the marks' stamp)
   ClothBoxGrid clothGrid;                    // the cloth particles alone at their predicted positions
   std::vector<float> triangleEdge2;          // m^2, each triangle's longest edge at the predicted positions, squared
   std::vector<float> vertexReach;            // m, per cloth particle: how near a path it is a candidate
