@@ -412,7 +412,8 @@ TrianglePlane trianglePlane(const Model& model, const Particles& p, const Coupli
   const Vec3 n1 = (p.xPred[f[1]] - p.xPred[f[0]]).cross(p.xPred[f[2]] - p.xPred[f[0]]);
   const float l1 = n1.norm();
   const Vec3 unit = l1 > 1e-12f ? Vec3(n1 / l1) : Vec3::Zero();
-  return {unit, model.pieces[clothPiece(p.phase[f[0]])].material.thickness, p.xPred[f[0]], s.triangleStiffness[t]};
+  return {unit, model.pieces[clothPiece(p.phase[f[0]])].material.thickness, p.xPred[f[0]], s.triangleStiffness[t],
+          Vec3::Zero(), 0.0f};
 }
 
 // how far (m) the passes may carry a water particle from the path its candidates were searched along
@@ -477,17 +478,16 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   const int iters = std::max(1, model.solver.couplingIterations);
   // the candidates' planes once per pass, shared by every water particle that tests the triangle
   s.plane.resize(nTri);
-  s.centroid.resize(nTri);
-  s.reach.resize(nTri);
   const uint32_t* activeTri = s.activeTriangles.data();
   parallelFor(static_cast<int64_t>(s.activeTriangles.size()), [&](int64_t k) {
     const size_t t = activeTri[k];
     const auto& f = model.triangles[t];
-    s.plane[t] = trianglePlane(model, p, s, t);
+    TrianglePlane& plane = s.plane[t];
+    plane = trianglePlane(model, p, s, t);
     const Vec3 c = (p.xPred[f[0]] + p.xPred[f[1]] + p.xPred[f[2]]) / 3.0f;
-    s.centroid[t] = c;
-    s.reach[t] = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
-                                     (p.xPred[f[2]] - c).squaredNorm()}));
+    plane.centroid = c;
+    plane.reach = std::sqrt(std::max({(p.xPred[f[0]] - c).squaredNorm(), (p.xPred[f[1]] - c).squaredNorm(),
+                                      (p.xPred[f[2]] - c).squaredNorm()}));
   });
 
   // chunks of water particles go to whichever thread is free; each chunk records its contacts in its
@@ -537,8 +537,8 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
           // Eq. 21 near the face: the closest point must lie within d/2 of q's projection on the plane
           // (below), and every point of the triangle is within reach of its centroid: a cheap test
           // that rejects no contact
-          const Vec3 toC = xq - s.centroid[tri];
-          const float lateral = s.reach[tri] + 0.5f * thickness;
+          const Vec3 toC = xq - plane.centroid;
+          const float lateral = plane.reach + 0.5f * thickness;
           if ((toC - toC.dot(n1) * n1).squaredNorm() > lateral * lateral) return false;
           Vec3 nrm;
           couplingConstraint(xq, p.xPred[f[0]], p.xPred[f[1]], p.xPred[f[2]], side, thickness, nrm, bary);
@@ -559,7 +559,9 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
         const float dl = -C / denom * kappa;
         const Vec3 g = side * n1;
         dq += wq * dl * g;
-        if (!rigidCloth) out.push_back({tri, -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
+        if (!rigidCloth)
+          out.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2]),
+                         -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
         return true;
       };
       // the rigid pass sweeps the candidates again, for paths through a face only, while it still
@@ -589,25 +591,22 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   }
   // cloth corrections summed in water order, averaged per vertex (Jacobi)
   uint64_t contacts = 0;
+  for (const auto& list : s.chunkContacts) contacts += list.size();
+  if (rigidCloth) return contacts;
   s.clothDelta.assign(static_cast<size_t>(nc), Vec3::Zero());
   s.clothCount.assign(static_cast<size_t>(nc), 0u);
-  for (const auto& list : s.chunkContacts) {
-    contacts += list.size();
-    if (rigidCloth) continue;
+  for (const auto& list : s.chunkContacts)
     for (const CouplingContact& c : list) {
-      const auto& f = model.triangles[c.triangle];
-      s.clothDelta[f[0]] += c.da;
-      s.clothDelta[f[1]] += c.db;
-      s.clothDelta[f[2]] += c.dc;
-      ++s.clothCount[f[0]];
-      ++s.clothCount[f[1]];
-      ++s.clothCount[f[2]];
+      s.clothDelta[c.a] += c.da;
+      s.clothDelta[c.b] += c.db;
+      s.clothDelta[c.c] += c.dc;
+      ++s.clothCount[c.a];
+      ++s.clothCount[c.b];
+      ++s.clothCount[c.c];
     }
-  }
-  if (!rigidCloth)
-    parallelFor(nc, [&](int64_t i) {
-      if (s.clothCount[i]) p.xPred[i] += s.clothDelta[i] / static_cast<float>(s.clothCount[i]);
-    });
+  parallelFor(nc, [&](int64_t i) {
+    if (s.clothCount[i]) p.xPred[i] += s.clothDelta[i] / static_cast<float>(s.clothCount[i]);
+  });
   return contacts;
 }
 

@@ -13,8 +13,8 @@
 namespace soak {
 
 struct CouplingContact {
-  uint32_t triangle;
-  Vec3 da, db, dc;   // m, corrections of the triangle's vertices
+  uint32_t a, b, c;  // the triangle's vertices
+  Vec3 da, db, dc;   // m, their corrections
 };
 
 // the cloth particles in a dense grid over the sheet's bounding box, sorted by cell (x fastest), so
@@ -47,6 +47,8 @@ struct TrianglePlane {
   float thickness;   // m
   Vec3 origin;       // m
   float stiffness;   // kappa^couple (Eq. 22)
+  Vec3 centroid;     // m (set by the passes for the candidates; the second search does not read it)
+  float reach;       // m, the farthest vertex from the centroid
 };
 
 struct CouplingScratch {
@@ -71,9 +73,7 @@ struct CouplingScratch {
   std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
   std::vector<uint8_t> triangleActive;       // 1: the triangle is some water particle's candidate this substep
   std::vector<uint32_t> activeTriangles;     // those triangles, ascending: the passes compute their planes only
-  std::vector<TrianglePlane> plane;          // each active triangle's plane at the predicted positions
-  std::vector<Vec3> centroid;                // m, of each triangle at the predicted positions
-  std::vector<float> reach;                  // m, the farthest vertex from the centroid
+  std::vector<TrianglePlane> plane;          // each active triangle's plane and centroid at the predicted positions
   std::vector<Vec3> clothDelta;
   std::vector<uint32_t> clothCount;
   std::vector<float> triangleStiffness;   // kappa^couple per triangle (Eq. 22 drives it; 1 when dry)
