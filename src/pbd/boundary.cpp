@@ -39,7 +39,10 @@ float wallKernelFraction(float d, float h, float* dFraction) {
     return h2 * h2 * h2 * h2 * t - 4.0 / 3.0 * h2 * h2 * h2 * t2 * t + 6.0 / 5.0 * h2 * h2 * t2 * t2 * t -
            4.0 / 7.0 * h2 * t2 * t2 * t2 * t + t2 * t2 * t2 * t2 * t / 9.0;
   };
-  const double k = 315.0 / (256.0 * std::pow(hh, 9));  // K pi / 4 with K = 315 / (64 pi h^9)
+  // K pi / 4 with K = 315 / (64 pi h^9); the last h's value kept per thread (nearly every call has the same h)
+  thread_local double lastH = -1.0, lastK = 0.0;
+  if (hh != lastH) lastH = hh, lastK = 315.0 / (256.0 * std::pow(hh, 9));
+  const double k = lastK;
   const double beyond = k * (antiderivative(hh) - antiderivative(z));
   const double q = h2 - z * z;
   if (dFraction) *dFraction = static_cast<float>(-k * q * q * q * q);  // the same on both sides
