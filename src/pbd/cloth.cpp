@@ -46,8 +46,22 @@ namespace {
 // a local whose address is taken becomes a per-lane array in memory, and the loop does not vectorise.
 // Gradients: the closed forms of Bridson et al. 2003 (a wing moves the angle by 1/height along the
 // normal; the edge vertices take the share that keeps the sum zero and rotations free).
+// Solve: also the XPBD update of each constraint (bendRange's arithmetic, in the same loop so the
+// gradients stay in registers): G then holds the particles' moves w_v grad_v C dlambda, lambda is updated
+struct BendSolve {
+  const float* compliance;
+  float invDt2;
+  const float* w;
+  float* lambda;
+};
+
+template <bool Solve>
 void bendKernel(int begin, int end, const int* __restrict I, const float* __restrict rest, const float* __restrict X,
-                float* __restrict Cout, float* __restrict G, int stride) {
+                float* __restrict Cout, float* __restrict G, int stride, BendSolve solve = {}) {
+  const float* __restrict const compliance = solve.compliance;
+  const float* __restrict const w = solve.w;
+  float* __restrict const lambda = solve.lambda;
+  const float invDt2 = solve.invDt2;
 #pragma omp simd
   for (int k = begin; k < end; ++k) {
     const int i0 = I[4 * k], i1 = I[4 * k + 1], i2 = I[4 * k + 2], i3 = I[4 * k + 3];
@@ -72,23 +86,34 @@ void bendKernel(int begin, int end, const int* __restrict I, const float* __rest
     const float sc = (cx * ex + cy * ey + cz * ez) / std::max(len2, 1e-20f);  // where c projects on the edge, 0 at a, 1 at b
     const float sd = (dx * ex + dy * ey + dz * ez) / std::max(len2, 1e-20f);
     const float ac = -(1.0f - sc), ad = -(1.0f - sd);
-    G[k] = ac * gcx + ad * gdx;
-    G[stride + k] = ac * gcy + ad * gdy;
-    G[2 * stride + k] = ac * gcz + ad * gdz;
-    G[3 * stride + k] = -sc * gcx - sd * gdx;
-    G[4 * stride + k] = -sc * gcy - sd * gdy;
-    G[5 * stride + k] = -sc * gcz - sd * gdz;
-    G[6 * stride + k] = gcx;
-    G[7 * stride + k] = gcy;
-    G[8 * stride + k] = gcz;
-    G[9 * stride + k] = gdx;
-    G[10 * stride + k] = gdy;
-    G[11 * stride + k] = gdz;
+    const float g[12] = {ac * gcx + ad * gdx, ac * gcy + ad * gdy, ac * gcz + ad * gdz,
+                         -sc * gcx - sd * gdx, -sc * gcy - sd * gdy, -sc * gcz - sd * gdz,
+                         gcx, gcy, gcz, gdx, gdy, gdz};
     // the short way round, so a fold through +-pi does not unwind a whole turn
     float C = theta - rest[k];
     C -= (C > kPi ? 2.0f * kPi : 0.0f);
     C += (C < -kPi ? 2.0f * kPi : 0.0f);
-    Cout[k] = z * C;
+    C = z * C;
+    if constexpr (!Solve) {
+      for (int c = 0; c < 12; ++c) G[c * stride + k] = g[c];
+      Cout[k] = C;
+    } else {
+      // XPBD (Macklin et al. 2016, Eq. 17-18), as stretchRange
+      const float w0 = w[i0], w1 = w[i1], w2 = w[i2], w3 = w[i3];
+      float q0 = 0.0f, q1 = 0.0f, q2 = 0.0f, q3 = 0.0f;  // |grad_v C|^2
+      for (int c = 0; c < 3; ++c) {
+        q0 += g[c] * g[c];
+        q1 += g[3 + c] * g[3 + c];
+        q2 += g[6 + c] * g[6 + c];
+        q3 += g[9 + c] * g[9 + c];
+      }
+      const float alpha = compliance[k] * invDt2;
+      const float denom = alpha + w0 * q0 + w1 * q1 + w2 * q2 + w3 * q3;
+      const float dl = denom > 0.0f ? (-C - alpha * lambda[k]) / std::max(denom, 1e-30f) : 0.0f;
+      lambda[k] += dl;
+      const float f[4] = {w0 * dl, w1 * dl, w2 * dl, w3 * dl};
+      for (int c = 0; c < 12; ++c) G[c * stride + k] = g[c] * f[c / 3];
+    }
   }
 }
 
@@ -102,7 +127,7 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
   const float X[12] = {a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()};
   const int I[4] = {0, 1, 2, 3};
   float C, G[12];
-  bendKernel(0, 1, I, &restAngle, X, &C, G, 1);
+  bendKernel<false>(0, 1, I, &restAngle, X, &C, G, 1);
   for (int v = 0; v < 4; ++v) grad[v] = Vec3(G[3 * v], G[3 * v + 1], G[3 * v + 2]);
   return C;
 }
@@ -141,34 +166,8 @@ void stretchRange(int begin, int end, const int* __restrict I, const float* __re
 
 void bendRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
                const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
-               float* __restrict lambda, float* __restrict out, float* __restrict C, size_t strideSize) {
-  const int stride = static_cast<int>(strideSize);
-  bendKernel(begin, end, I, rest, X, C, out, stride);
-#pragma omp simd
-  for (int k = begin; k < end; ++k) {
-    const int i0 = I[4 * k], i1 = I[4 * k + 1], i2 = I[4 * k + 2], i3 = I[4 * k + 3];
-    const float w0 = w[i0], w1 = w[i1], w2 = w[i2], w3 = w[i3];
-    float q0 = 0.0f, q1 = 0.0f, q2 = 0.0f, q3 = 0.0f;  // |grad_v C|^2
-#pragma GCC unroll 3
-    for (int c = 0; c < 3; ++c) {
-      q0 += out[c * stride + k] * out[c * stride + k];
-      q1 += out[(3 + c) * stride + k] * out[(3 + c) * stride + k];
-      q2 += out[(6 + c) * stride + k] * out[(6 + c) * stride + k];
-      q3 += out[(9 + c) * stride + k] * out[(9 + c) * stride + k];
-    }
-    const float alpha = compliance[k] * invDt2;
-    const float denom = alpha + w0 * q0 + w1 * q1 + w2 * q2 + w3 * q3;
-    const float dl = denom > 0.0f ? (-C[k] - alpha * lambda[k]) / std::max(denom, 1e-30f) : 0.0f;
-    lambda[k] += dl;
-    const float f0 = w0 * dl, f1 = w1 * dl, f2 = w2 * dl, f3 = w3 * dl;
-#pragma GCC unroll 3
-    for (int c = 0; c < 3; ++c) {
-      out[c * stride + k] *= f0;
-      out[(3 + c) * stride + k] *= f1;
-      out[(6 + c) * stride + k] *= f2;
-      out[(9 + c) * stride + k] *= f3;
-    }
-  }
+               float* __restrict lambda, float* __restrict out, size_t strideSize) {
+  bendKernel<true>(begin, end, I, rest, X, nullptr, out, static_cast<int>(strideSize), {compliance, invDt2, w, lambda});
 }
 
 }  // namespace
@@ -185,7 +184,6 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   scratch.bendLambda.assign(bd.ids.size(), 0.0f);
   scratch.correction.resize(6 * st.ids.size());
   scratch.correctionBend.resize(12 * bd.ids.size());
-  scratch.bendC.resize(bd.ids.size());
   if (model.numCloth == 0 || dt <= 0.0f) return;
   const float invDt2 = 1.0f / (dt * dt);
   Vec3* x = p.xPred.data();
@@ -208,7 +206,7 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   };
   const auto bendBlock = [&](int begin, int end) {
     bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
-              bendLambda, corrBend, scratch.bendC.data(), strideBend);
+              bendLambda, corrBend, strideBend);
     for (int k = begin; k < end; ++k)
       for (int v = 0; v < 4; ++v)
         x[bd.ids[k][v]] += Vec3(corrBend[(3 * v) * strideBend + k], corrBend[(3 * v + 1) * strideBend + k],

@@ -40,7 +40,6 @@ struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
   std::vector<float> correction;      // m, the moves of the stretch constraints' particles, 6 per constraint (SoA)
   std::vector<float> correctionBend;  // m, the same for the bend constraints, 12 per constraint
-  std::vector<float> bendC;       // rad, C of each bend constraint of the colour being solved
   std::vector<Vec3> delta;
   std::vector<int> deltaCount;
 };
