@@ -162,8 +162,8 @@ TEST(ColliderDistance, ContainerCavityWallsAndOpenTop) {
 
 // the normal is the gradient of the distance: central differences at random points away from the
 // kinks (where the finite-difference gradient is not unit length)
-TEST(ColliderDistance, NormalsMatchFiniteDifferences) {
-  std::vector<Collider> shapes;
+// one collider of every analytic shape, sized to fit the points of the tests below (|x| < 0.8)
+std::vector<Collider> everyShape() {
   Collider box = makeCollider(ColliderShape::Box);
   box.halfExtents = Vec3(0.4f, 0.25f, 0.3f);
   Collider sphere = makeCollider(ColliderShape::Sphere);
@@ -174,7 +174,11 @@ TEST(ColliderDistance, NormalsMatchFiniteDifferences) {
   Collider container = makeCollider(ColliderShape::Container);
   container.halfExtents = Vec3(0.4f, 0.3f, 0.35f);
   container.wallThickness = 0.05f;
-  shapes = {makeCollider(ColliderShape::Plane), box, sphere, capsule, container};
+  return {makeCollider(ColliderShape::Plane), box, sphere, capsule, container};
+}
+
+TEST(ColliderDistance, NormalsMatchFiniteDifferences) {
+  const std::vector<Collider> shapes = everyShape();
   const ColliderPose pose = staticPose(Vec3(0.1f, -0.2f, 0.3f), aroundAxis(0.7f, Vec3(1, 2, 3)));
   std::mt19937 rng(12345);
   std::uniform_real_distribution<float> u(-0.8f, 0.8f);
@@ -206,17 +210,7 @@ TEST(ColliderDistance, VectorisedBoundsAreBelowTheExactDistanceAndClose) {
   // colliderDistance: never above it (a particle it skips cannot be in contact), at most the slack
   // below it, for every shape in a rotated, moved frame; points on both sides of every surface, more
   // than a chunk of them, and an out[] already lower stays
-  Collider box = makeCollider(ColliderShape::Box);
-  box.halfExtents = Vec3(0.4f, 0.25f, 0.3f);
-  Collider sphere = makeCollider(ColliderShape::Sphere);
-  sphere.radius = 0.35f;
-  Collider capsule = makeCollider(ColliderShape::Capsule);
-  capsule.radius = 0.15f;
-  capsule.halfHeight = 0.3f;
-  Collider container = makeCollider(ColliderShape::Container);
-  container.halfExtents = Vec3(0.4f, 0.3f, 0.35f);
-  container.wallThickness = 0.05f;
-  const std::vector<Collider> shapes = {makeCollider(ColliderShape::Plane), box, sphere, capsule, container};
+  const std::vector<Collider> shapes = everyShape();
   const ColliderPose pose = staticPose(Vec3(0.1f, -0.2f, 0.3f), aroundAxis(0.7f, Vec3(1, 2, 3)));
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-0.8f, 0.8f);
