@@ -359,9 +359,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
         s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(at);
     }
   }
-  // the triangles some particle has as a candidate: the passes need the planes of these only (in Fig. 1
-  // the 2.5k water particles near a 28k-triangle sheet have a few thousand)
-  // (marked as they are found, above)
+  // the triangles some particle has as a candidate (marked as they were found): the passes need the
+  // planes of these only (in Fig. 1 the 2.5k water particles near a 28k-triangle sheet have a few thousand)
   s.activeTriangles.clear();
   for (size_t t = 0; t < nTri; ++t)
     if (active[t]) s.activeTriangles.push_back(static_cast<uint32_t>(t));
