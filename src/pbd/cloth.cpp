@@ -277,12 +277,14 @@ void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& n
       const Vec3 xij = xi - x[j];
       const float dist2 = xij.squaredNorm();
       if (dist2 >= t2 || dist2 < 1e-24f) continue;
+      // the 1-ring next (most of the near pairs: the mesh spacing is about the thickness), from i's own
+      // cached list before j's phase, mass and rest position are loaded
+      if (std::binary_search(ringBegin, ringEnd, j)) continue;
       if (j == i || p.phase[j] != p.phase[i]) continue;
       const float wSum = w[i] + w[j];
       if (wSum == 0.0f) continue;
       // pairs that are this close at rest belong together (fine meshes, seams): leave them to Eq. 8
       if ((rest[i] - rest[j]).squaredNorm() <= t2) continue;
-      if (std::binary_search(ringBegin, ringEnd, j)) continue;
       const float dist = std::sqrt(dist2);
       sum += (w[i] / wSum * (thickness - dist) / dist) * xij;
       ++contacts;
