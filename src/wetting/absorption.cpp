@@ -93,7 +93,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     const float before = p.mass[j];
     const float after = before - loss;
     if (after < minMass) {
-      s.waterLost[j] = before;  // full absorption: the particle leaves at the end of the substep
+      s.waterLost[j] = before;  // full absorption: the particle leaves at the end of the wetting pass
       s.keep[j] = 0;
       p.mass[j] = 0.0f;
       return;

@@ -277,7 +277,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
         placed = dripDensity(model, p, grid, gridSize, s, y, mDrip, hDrip) <= rho0;
       }
     }
-    if (!placed) continue;  // crowded: try again next substep
+    if (!placed) continue;  // crowded: try again at the next wetting pass
     const uint32_t id = state.nextId++;
     p.add(kWaterPhase, id, mDrip, hDrip, y, p.v[i]);
     state.clothBuffer[i] -= static_cast<double>(mDrip);

@@ -1,6 +1,7 @@
 // cloth wetting of Shao, Wu, Wang 2017 section 4: cloth particles are porous and hold water. One
-// model per file, each a stage of the substep (src/pbd/step.cpp), in the order of Algorithm 1:
-//   permeability.cpp  Eq. 22   coupling stiffness from saturation (before the coupling)
+// model per file, each a stage of the wetting pass after a step's last substep (src/pbd/step.cpp;
+// wetting.everySubstep: after every substep), in the order of Algorithm 1:
+//   permeability.cpp  Eq. 22   coupling stiffness from saturation (before the coupling, every substep)
 //   porosity.cpp      Eq. 10   particle volume, saturation, wet mass
 //   absorption.cpp    Eq. 11   water particles soak into the cloth (gravity weighted)
 //   diffusion.cpp     Eq. 12-17 water spreads inside the cloth (PBD projection, pairwise exchange)
@@ -34,13 +35,13 @@ inline T* threadBuffer(size_t n) {
   return buffer.data();
 }
 
-// scratch of the wetting stages, reused from substep to substep
+// scratch of the wetting stages, reused from pass to pass
 struct WettingScratch {
-  std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this substep
+  std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this pass
   std::vector<float> capacity;     // kg a cloth particle can still absorb (Eq. 11)
   std::vector<float> clothScale;   // share of its requests a cloth particle grants (Eq. 11)
   std::vector<float> waterScale;   // share of its mass a water particle can give (Eq. 11)
-  std::vector<double> waterLost;   // kg each water particle lost to the cloth this substep
+  std::vector<double> waterLost;   // kg each water particle lost to the cloth this pass
   std::vector<uint8_t> isDrip;     // water particles hanging as drips (not absorbed)
   std::vector<uint8_t> keep;       // 0 for water absorbed whole; compacted by finishWetting
   bool anyAbsorbedWhole = false;
@@ -50,7 +51,7 @@ struct WettingScratch {
   std::vector<float> outScale;     // keeps a buffer's outflow within the buffer (Eq. 18)
   std::vector<int64_t> dripOf;     // index of the drip hanging from each cloth particle, -1 when none
   std::vector<Vec3> force;         // N, sticking force per cloth particle (Eq. 20)
-  // geometry of the cloth pairs at this substep's positions x (pairGeometry), one value per entry e of
+  // geometry of the cloth pairs at this pass's positions x (pairGeometry), one value per entry e of
   // the cloth part [start[i], clothEnd(i)) of a cloth particle i's neighbour list, j = index[e], with
   // h_ij = pairRadius(h_i, h_j) and x_ij = x_i - x_j; the other entries are not set. Porosity,
   // diffusion and emission read them instead of each taking a norm and divisions per pair.
@@ -98,7 +99,7 @@ void initWettingState(const Model& model, const std::vector<float>& volume, Stat
 void clothVolumes(const Model& model, const std::vector<Vec3>& x, const std::vector<float>& radius,
                   const std::vector<int32_t>& phase, const NeighborLists& nb, std::vector<float>& volume);
 
-// Eq. 10 at this substep's positions: V_i, S_i = c m^water_i / V_i, and the wet mass
+// Eq. 10 at this pass's positions: V_i, S_i = c m^water_i / V_i, and the wet mass
 // m_i = dry + held + buffer (pinned particles keep inverse mass 0)
 void updatePorosity(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s);
 
@@ -106,7 +107,7 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
 // the positions p.x (one vectorised pass); updatePorosity calls it, and diffusion and emission call
 // ensurePairGeometry, which computes it only when the scratch holds none for these lists (a stage
 // run on its own, as in the tests). Positions must not change between updatePorosity and the stages
-// that read the pairs (they do not in a substep: x is committed before the wetting stages).
+// that read the pairs (they do not within a pass: x is committed before the wetting stages).
 void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
 void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
 
@@ -137,7 +138,7 @@ void scaleBoundaryByPermeability(const Model& model, const State& state, std::ve
 size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
 
 // removes the water absorbed whole (stable compaction, ids kept) and brings the ledger's held and
-// buffered totals up to date; the last wetting stage of a substep
+// buffered totals up to date; the last wetting stage of a pass
 void finishWetting(const Model& model, State& state, WettingScratch& s);
 
 // diffusion.cpp -----------------------------------------------------------------------------------
