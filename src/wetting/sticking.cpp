@@ -31,25 +31,66 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
   Particles& p = state.particles;
   const std::vector<float>& sat = state.clothSaturation;
   s.force.resize(static_cast<size_t>(nc));
-  // gathered per particle; the pair's force is bit for bit opposite seen from the other side
+  // gathered per particle; the pair's force is bit for bit opposite seen from the other side. The
+  // pairs' terms in a vectorised loop (plain floats, selects: stickingCoefficient, poly6 and the tests
+  // below with the same arithmetic) into a per-thread buffer, summed in list order: the scalar loop's
+  // result (a skipped pair adds +0). Pointers copied to locals: GCC does not vectorise through captures
+  const float* const xAll = p.x[0].data();
+  const float* const restAll = model.clothRestPosition[0].data();
+  const float* const radiusAll = p.radius.data();
+  const int32_t* const phaseAll = p.phase.data();
+  const float* const satAll = sat.data();
+  const uint32_t* const indexAll = nb.index.data();
+  const float st = w.saturationSticky, rate = w.stickingRate, strength = w.stickingStrength;
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     Vec3 f = Vec3::Zero();
     if (sat[i] > 0.0f) {
-      for (uint32_t e = nb.start[i], end = nb.clothEnd(i, static_cast<uint32_t>(nc)); e < end; ++e) {
-        const int64_t j = nb.index[e];
-        if (j >= nc || !(sat[j] > 0.0f)) continue;
-        const float hij = pairRadius(p.radius[i], p.radius[j]);
+      const uint32_t begin = nb.start[i], count = nb.clothEnd(i, static_cast<uint32_t>(nc)) - begin;
+      const uint32_t* const J = indexAll + begin;
+      const float* const X = xAll;
+      const float* const R = restAll;
+      const float* const H = radiusAll;
+      const int32_t* const P = phaseAll;
+      const float* const S = satAll;
+      float* const Tx = threadBuffer<float>(3 * static_cast<size_t>(count));
+      float* const Ty = Tx + count;
+      float* const Tz = Ty + count;
+      const uint32_t cloth = static_cast<uint32_t>(nc), self = static_cast<uint32_t>(i);
+      const float si = S[i], hi = H[i], xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+      const float rxi = R[3 * i], ryi = R[3 * i + 1], rzi = R[3 * i + 2];
+      const int32_t phi = P[i];
+      const float stL = st, rateL = rate, strengthL = strength;
+      const float rampI = stL > 0.0f ? (si / stL < 1.0f ? si / stL : 1.0f) : 1.0f;  // min(1, S_i / S^T)
+#pragma omp simd
+      for (uint32_t k = 0; k < count; ++k) {
+        const uint32_t j = J[k];
+        const bool isCloth = j < cloth;
+        const uint32_t jj = isCloth ? j : self;  // water entries read i's own row, then drop out
+        const float sj = S[jj];
+        const float hij = 0.5f * (hi + H[jj]);  // pairRadius
         // neighbours on the rest shape are not "touching": the cloth holds them, not the water
-        if (p.phase[j] == p.phase[i] &&
-            (model.clothRestPosition[i] - model.clothRestPosition[j]).squaredNorm() < 2.25f * hij * hij)
-          continue;
-        const float coef = stickingCoefficient(w, sat[i], sat[j]);
-        if (coef <= 0.0f) continue;
-        const Vec3 r = p.x[j] - p.x[i];
-        const float r2 = r.squaredNorm();
-        if (r2 >= hij * hij || r2 < 1e-18f) continue;
-        f += (coef * poly6(r2, hij) / poly6(0.0f, hij) / std::sqrt(r2)) * r;
+        const float ex = rxi - R[3 * jj], ey = ryi - R[3 * jj + 1], ez = rzi - R[3 * jj + 2];
+        const bool onRest = (P[jj] == phi) & (ex * ex + (ey * ey + ez * ez) < 2.25f * hij * hij);
+        // stickingCoefficient(w, S_i, S_j), S_i > 0 already
+        const float fc = strengthL - rateL * std::fabs((si - stL) * (sj - stL));
+        const float rampJ = stL > 0.0f ? (sj / stL < 1.0f ? sj / stL : 1.0f) : 1.0f;
+        const float coef = fc * (stL > 0.0f ? rampI * rampJ : 1.0f);
+        const float rx = X[3 * jj] - xi, ry = X[3 * jj + 1] - yi, rz = X[3 * jj + 2] - zi;  // x_j - x_i
+        const float r2 = rx * rx + (ry * ry + rz * rz);
+        const float h2 = hij * hij;
+        const bool ok = isCloth & (sj > 0.0f) & !onRest & (fc > 0.0f) & (coef > 0.0f) & (r2 < h2) & (r2 >= 1e-18f);
+        // poly6(r2, h_ij) / poly6(0, h_ij)
+        const float h9 = h2 * h2 * h2 * h2 * hij;
+        const float kern = 315.0f / (64.0f * kPi * h9);
+        const float d = h2 - r2;
+        const float w6 = kern * d * d * d, w0 = kern * h2 * h2 * h2;
+        const float rs = ok ? r2 : 1.0f;
+        const float sc = ok ? coef * w6 / w0 / std::sqrt(rs) : 0.0f;
+        Tx[k] = sc * rx;
+        Ty[k] = sc * ry;
+        Tz[k] = sc * rz;
       }
+      for (uint32_t k = 0; k < count; ++k) f += Vec3(Tx[k], Ty[k], Tz[k]);
     }
     s.force[i] = f;
   });
