@@ -61,6 +61,23 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
       const int32_t phi = P[i];
       const float stL = st, rateL = rate, strengthL = strength;
       const float rampI = stL > 0.0f ? (si / stL < 1.0f ? si / stL : 1.0f) : 1.0f;  // min(1, S_i / S^T)
+      // most of a sheet touches only its rest-shape neighbours: count the wet pairs that are not
+      // (a cheap loop) and skip the particle when there are none
+      int touching = 0;
+#pragma omp simd reduction(+ : touching)
+      for (uint32_t k = 0; k < count; ++k) {
+        const uint32_t j = J[k];
+        const bool isCloth = j < cloth;
+        const uint32_t jj = isCloth ? j : self;
+        const float hij = 0.5f * (hi + H[jj]);
+        const float ex = rxi - R[3 * jj], ey = ryi - R[3 * jj + 1], ez = rzi - R[3 * jj + 2];
+        const bool onRest = (P[jj] == phi) & (ex * ex + (ey * ey + ez * ez) < 2.25f * hij * hij);
+        touching += isCloth & (S[jj] > 0.0f) & !onRest ? 1 : 0;
+      }
+      if (touching == 0) {
+        s.force[i] = f;
+        return;
+      }
 #pragma omp simd
       for (uint32_t k = 0; k < count; ++k) {
         const uint32_t j = J[k];
