@@ -241,6 +241,21 @@ inline float sum(__m512 a) {
 }  // namespace v16
 #endif
 
+// entry k of a list in the scalar tails of the pair loops: the neighbour j, x_i - x_j, its square
+// and the pair's support radius and inverse
+struct ScalarPair {
+  uint32_t j;
+  float rx, ry, rz, r2, kh, kinv;
+};
+template <bool U>
+inline ScalarPair scalarPair(const PairInputs& in, uint32_t k, float xi, float yi, float zi, float hi) {
+  const uint32_t j = in.index[k];
+  const float* X = in.X;
+  const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+  const float kh = U ? in.hU : 0.5f * (hi + in.H[j]);
+  return {j, rx, ry, rz, rx * rx + ry * ry + rz * rz, kh, U ? in.invU : 1.0f / kh};
+}
+
 // lambda pass of water particle i over its neighbours [k0, k1): rho_i without itself, grad_i C_i
 // without the walls (times rho0) and sum_j w_j |grad_j C_i|^2
 template <bool U>
@@ -285,10 +300,7 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
   }
 #endif
   for (; k < k1; ++k) {
-    const uint32_t j = in.index[k];
-    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-    const float r2 = rx * rx + ry * ry + rz * rz;
-    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]), kinv = U ? in.invU : 1.0f / kh;
+    const auto [j, rx, ry, rz, r2, kh, kinv] = scalarPair<U>(in, k, xi, yi, zi, hi);
     const float mj = in.M[j];
     r += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
     const float sf = spikyFactorOf(kh, spikyCoefOf(kinv), r2), f = mj * in.invRho0 * sf;
@@ -382,10 +394,7 @@ inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t 
   }
 #endif
   for (; k < k1; ++k) {
-    const uint32_t j = in.index[k];
-    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-    const float r2 = rx * rx + ry * ry + rz * rz;
-    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]), kinv = U ? in.invU : 1.0f / kh;
+    const auto [j, rx, ry, rz, r2, kh, kinv] = scalarPair<U>(in, k, xi, yi, zi, hi);
     const float sc = Tensile && in.phase[j] == kWaterPhase
                          ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, r2, kh * kh)
                          : 0.0f;

@@ -61,6 +61,11 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
       const int32_t phi = P[i];
       const float stL = st, rateL = rate, strengthL = strength;
       const float rampI = stL > 0.0f ? (si / stL < 1.0f ? si / stL : 1.0f) : 1.0f;  // min(1, S_i / S^T)
+      // neighbours on the rest shape are not "touching": the cloth holds them, not the water
+      const auto onRest = [=](uint32_t jj, float hij) {
+        const float ex = rxi - R[3 * jj], ey = ryi - R[3 * jj + 1], ez = rzi - R[3 * jj + 2];
+        return (P[jj] == phi) & (ex * ex + (ey * ey + ez * ez) < 2.25f * hij * hij);
+      };
       // most of a sheet touches only its rest-shape neighbours: count the wet pairs that are not
       // (a cheap loop) and skip the particle when there are none
       int touching = 0;
@@ -69,10 +74,7 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
         const uint32_t j = J[k];
         const bool isCloth = j < cloth;
         const uint32_t jj = isCloth ? j : self;
-        const float hij = 0.5f * (hi + H[jj]);
-        const float ex = rxi - R[3 * jj], ey = ryi - R[3 * jj + 1], ez = rzi - R[3 * jj + 2];
-        const bool onRest = (P[jj] == phi) & (ex * ex + (ey * ey + ez * ez) < 2.25f * hij * hij);
-        touching += isCloth & (S[jj] > 0.0f) & !onRest ? 1 : 0;
+        touching += isCloth & (S[jj] > 0.0f) & !onRest(jj, 0.5f * (hi + H[jj])) ? 1 : 0;
       }
       if (touching == 0) {
         s.force[i] = f;
@@ -85,9 +87,6 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
         const uint32_t jj = isCloth ? j : self;  // water entries read i's own row, then drop out
         const float sj = S[jj];
         const float hij = 0.5f * (hi + H[jj]);  // pairRadius
-        // neighbours on the rest shape are not "touching": the cloth holds them, not the water
-        const float ex = rxi - R[3 * jj], ey = ryi - R[3 * jj + 1], ez = rzi - R[3 * jj + 2];
-        const bool onRest = (P[jj] == phi) & (ex * ex + (ey * ey + ez * ez) < 2.25f * hij * hij);
         // stickingCoefficient(w, S_i, S_j), S_i > 0 already
         const float fc = strengthL - rateL * std::fabs((si - stL) * (sj - stL));
         const float rampJ = stL > 0.0f ? (sj / stL < 1.0f ? sj / stL : 1.0f) : 1.0f;
@@ -95,7 +94,7 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
         const float rx = X[3 * jj] - xi, ry = X[3 * jj + 1] - yi, rz = X[3 * jj + 2] - zi;  // x_j - x_i
         const float r2 = rx * rx + (ry * ry + rz * rz);
         const float h2 = hij * hij;
-        const bool ok = isCloth & (sj > 0.0f) & !onRest & (fc > 0.0f) & (coef > 0.0f) & (r2 < h2) & (r2 >= 1e-18f);
+        const bool ok = isCloth & (sj > 0.0f) & !onRest(jj, hij) & (fc > 0.0f) & (coef > 0.0f) & (r2 < h2) & (r2 >= 1e-18f);
         // poly6(r2, h_ij) / poly6(0, h_ij)
         const float h9 = h2 * h2 * h2 * h2 * hij;
         const float kern = 315.0f / (64.0f * kPi * h9);
