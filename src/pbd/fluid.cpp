@@ -146,8 +146,9 @@ struct PairInputs {
   float invRho0;
   float sCorrK, oneMinusDq2;
   int tensileN;
-  // the pair cache (FluidScratch::pairG*): the lambda pass writes m_j sf_ij r_ij and |r_ij|^2 of list
-  // entry k at [k - cacheBase], the correction pass of the same iteration reads them; null when off
+  // the pair cache (FluidScratch::pairG*): the lambda pass writes m_j sf_ij r_ij and |r_ij|^2 (only
+  // with artificial pressure; cacheR2 null without) of list entry k at [k - cacheBase], the correction
+  // pass of the same iteration reads them; null when off
   float* cacheGx = nullptr;
   float* cacheGy = nullptr;
   float* cacheGz = nullptr;
@@ -286,7 +287,7 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
         _mm512_mask_storeu_ps(in.cacheGx + at, m, mul(g, rx));
         _mm512_mask_storeu_ps(in.cacheGy + at, m, mul(g, ry));
         _mm512_mask_storeu_ps(in.cacheGz + at, m, mul(g, rz));
-        _mm512_mask_storeu_ps(in.cacheR2 + at, m, r2);
+        if (in.cacheR2) _mm512_mask_storeu_ps(in.cacheR2 + at, m, r2);
       }
       sGx = add(sGx, mul(f, rx));
       sGy = add(sGy, mul(f, ry));
@@ -307,7 +308,8 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
     if (in.cacheGx) {
       const float g = mj * sf;
       const uint32_t at = k - in.cacheBase;
-      in.cacheGx[at] = g * rx, in.cacheGy[at] = g * ry, in.cacheGz[at] = g * rz, in.cacheR2[at] = r2;
+      in.cacheGx[at] = g * rx, in.cacheGy[at] = g * ry, in.cacheGz[at] = g * rz;
+      if (in.cacheR2) in.cacheR2[at] = r2;
     }
     gx += f * rx;
     gy += f * ry;
@@ -501,14 +503,16 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const uint8_t* const mixed = s.mixedRadius.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
                 nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
-  // the pair cache: 16 bytes a pair of the water's lists, when that fits s.pairCacheLimit (not the
-  // 1M-particle block: its memory target). It spares the correction pass four gathers, a square root
-  // and a division a pair
+  // the pair cache: 12 bytes a pair of the water's lists (16 with artificial pressure, whose s_corr
+  // needs |r|^2), when that fits s.pairCacheLimit (not the 1M-particle block: its memory target). It
+  // spares the correction pass four gathers, a square root and a division a pair
   const size_t waterPairs = nb.start[n] - nb.start[static_cast<size_t>(nc)];
-  if (waterPairs * 4 * sizeof(float) <= s.pairCacheLimit) {
-    for (std::vector<float>* v : {&s.pairGx, &s.pairGy, &s.pairGz, &s.pairR2}) v->resize(waterPairs);
+  const bool tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
+  if (waterPairs * (tensile ? 4 : 3) * sizeof(float) <= s.pairCacheLimit) {
+    for (std::vector<float>* v : {&s.pairGx, &s.pairGy, &s.pairGz}) v->resize(waterPairs);
+    s.pairR2.resize(tensile ? waterPairs : 0);
     in.cacheGx = s.pairGx.data(), in.cacheGy = s.pairGy.data(), in.cacheGz = s.pairGz.data();
-    in.cacheR2 = s.pairR2.data();
+    in.cacheR2 = tensile ? s.pairR2.data() : nullptr;  // unread by the correction pass without s_corr
     in.cacheBase = nb.start[static_cast<size_t>(nc)];
   }
   const auto solve = [&](auto uniform, auto tensile) {
@@ -564,7 +568,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       });
     }
   };
-  withFlags(uniform, sCorrK != 0.0f, solve);  // s_corr is 0 without artificial pressure
+  withFlags(uniform, tensile, solve);
 }
 
 void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt) {

@@ -27,7 +27,8 @@ struct FluidScratch {
   std::vector<Vec3> wallFrom;      // m, where each water particle was when wallClear was measured
   // per entry of the water particles' neighbour lists, written by the lambda pass and read by the
   // correction pass of the same iteration: m_j sf_ij r_ij (kg m, the spiky gradient's factor sf) and
-  // |r_ij|^2 (m^2); used only while the four arrays take at most pairCacheLimit bytes
+  // |r_ij|^2 (m^2, only with artificial pressure: pairR2 is empty without); used only while the
+  // arrays take at most pairCacheLimit bytes
   std::vector<float> pairGx, pairGy, pairGz, pairR2;
   size_t pairCacheLimit = size_t(256) << 20;
 };
