@@ -45,6 +45,7 @@ struct BenchOptions {
   std::string manifest;                // empty: bench/benchmarks.json of the source tree
   std::vector<std::string> overrides;  // --set, applied to every scene
   bool inProcess = false;              // run the scenes in this process (no re-exec per scene)
+  bool wholeRun = false;               // time every step of the scene's own duration, no warm-up
   bool quiet = false;
 };
 

@@ -254,5 +254,45 @@ TEST(CliBench, TimesEachSceneInItsOwnProcess) {
   EXPECT_NE(bad.err.find("no_such_benchmark"), std::string::npos) << bad.err;
 }
 
+// --whole-run times every step of the scene's own duration (output.frames x stepsPerFrame: 3 x 2
+// here) without warm-up, and compares a target with the mean step, as Table 2 of Shao 2017 averages
+TEST(CliBench, WholeRunTimesEveryStepOfTheSceneAgainstTheMean) {
+  const Cli cli("bench_whole");
+  cli.writeScene("tiny.json", kTinyScene);
+  const std::string manifest = cli.writeScene("manifest.json", R"({"benchmarks": [
+    {"name": "fast", "scene": "tiny.json", "warmup": 4, "steps": 1, "targetMsPerStep": 100000},
+    {"name": "slow", "scene": "tiny.json", "warmup": 4, "steps": 1, "targetMsPerStep": 0.000001}]})");
+  const fs::path json = cli.dir() / "bench.json";
+  const Result r = cli.run("bench --manifest '" + manifest + "' --whole-run --threads 1 --json '" + json.string() + "'");
+  EXPECT_EQ(r.code, 0) << r.err;  // a missed target is reported, not an error
+  EXPECT_NE(r.out.find("(mean)"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("steps 6/6"), std::string::npos) << r.err;  // progress of the long runs
+  const nlohmann::json doc = nlohmann::json::parse(readTextFile(json.string()));
+  ASSERT_EQ(doc["results"].size(), 2u);
+  for (const nlohmann::json& res : doc["results"]) {
+    ASSERT_FALSE(res.contains("error")) << res.dump();
+    EXPECT_TRUE(res["wholeRun"].get<bool>());
+    EXPECT_EQ(res["warmup"], 0);  // the manifest's warm-up and steps do not apply
+    EXPECT_EQ(res["steps"], 6);
+    EXPECT_NEAR(res["simulatedSeconds"].get<double>(), 0.06, 1e-6);
+    EXPECT_EQ(res["particles"]["water"], kTinyWater);  // the block fired in the timed steps
+    const double mean = res["msPerStepMean"].get<double>();
+    EXPECT_GT(mean, 0.0);
+    EXPECT_DOUBLE_EQ(res["msPerStepMeanStages"]["total"].get<double>(), mean);
+    EXPECT_EQ(res["targets"]["msPerStepBasis"], "mean");
+  }
+  EXPECT_TRUE(doc["results"][0]["targets"]["msPerStepMet"].get<bool>());
+  EXPECT_FALSE(doc["results"][1]["targets"]["msPerStepMet"].get<bool>());
+  // a window of steps keeps the median as its basis; --whole-run with --steps or --warmup is refused
+  const Result window = cli.run("bench --manifest '" + manifest + "' --scene fast --threads 1 -q --json '" + json.string() + "'");
+  ASSERT_EQ(window.code, 0) << window.err;
+  const nlohmann::json one = nlohmann::json::parse(readTextFile(json.string()));
+  EXPECT_EQ(one["results"][0]["targets"]["msPerStepBasis"], "median");
+  EXPECT_EQ(one["results"][0]["steps"], 1);
+  EXPECT_FALSE(one["results"][0]["wholeRun"].get<bool>());
+  EXPECT_EQ(cli.run("bench --manifest '" + manifest + "' --whole-run --steps 3").code, 1);
+  EXPECT_EQ(cli.run("bench --manifest '" + manifest + "' --whole-run --warmup 3").code, 1);
+}
+
 }  // namespace
 }  // namespace soak
