@@ -8,6 +8,7 @@
 #endif
 
 #include <algorithm>
+#include <limits>
 
 namespace soak {
 
@@ -154,6 +155,61 @@ int denseRowRanges(const NeighborLists& lists, const Vec3& p, float cs, float re
   return count;
 }
 
+// the distance from a point at f (0..cs inside its cell, along one axis) to the cells o cells away
+// along that axis (0 for its own)
+inline float slabGap(float f, int o, float cs) {
+  return o < 0 ? f + static_cast<float>(-o - 1) * cs : (o > 0 ? static_cast<float>(o - 1) * cs + (cs - f) : 0.0f);
+}
+
+// the candidates of a particle at p whose reach spans more than one cell (a support radius above the
+// cell size: `buildNeighborLists`): every cell within `reach` of p, as ranges of the entries, in a
+// fixed order. Dense grid: one range per row (y, z) for the cells of the row it touches; hashed grid:
+// one range per bucket, each bucket once
+void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense, const Vec3& p, float cs, float reach,
+                std::vector<uint32_t>& ranges) {  // [begin, end) pairs, flat
+  ranges.clear();
+  const float reach2 = reach * reach;
+  const int R = static_cast<int>(std::ceil(reach / cs));
+  if (dense) {
+    const Eigen::Vector3i& d = lists.denseDims;
+    const Vec3 c = (p - lists.denseOrigin) / cs;
+    const int cell[3] = {std::min(static_cast<int>(c.x()), d.x() - 1), std::min(static_cast<int>(c.y()), d.y() - 1),
+                         std::min(static_cast<int>(c.z()), d.z() - 1)};
+    const float f[3] = {p.x() - (lists.denseOrigin.x() + cs * cell[0]), p.y() - (lists.denseOrigin.y() + cs * cell[1]),
+                        p.z() - (lists.denseOrigin.z() + cs * cell[2])};
+    for (int oz = -R; oz <= R; ++oz) {
+      const int z = cell[2] + oz;
+      if (z < 0 || z >= d.z()) continue;
+      for (int oy = -R; oy <= R; ++oy) {
+        const int y = cell[1] + oy;
+        if (y < 0 || y >= d.y()) continue;
+        const float gy = slabGap(f[1], oy, cs), gz = slabGap(f[2], oz, cs), yz2 = gy * gy + gz * gz;
+        if (yz2 >= reach2) continue;
+        int x0 = cell[0], x1 = cell[0];
+        while (x0 > 0 && x0 > cell[0] - R && yz2 + slabGap(f[0], x0 - 1 - cell[0], cs) * slabGap(f[0], x0 - 1 - cell[0], cs) < reach2) --x0;
+        while (x1 + 1 < d.x() && x1 < cell[0] + R && yz2 + slabGap(f[0], x1 + 1 - cell[0], cs) * slabGap(f[0], x1 + 1 - cell[0], cs) < reach2) ++x1;
+        const size_t row = static_cast<size_t>(z * d.y() + y) * d.x();
+        const uint32_t k0 = lists.denseStart[row + x0], k1 = lists.denseStart[row + x1 + 1];
+        if (k0 != k1) ranges.insert(ranges.end(), {k0, k1});
+      }
+    }
+    return;
+  }
+  const Eigen::Vector3i c = grid.cellOf(p);
+  const float f[3] = {p.x() - cs * c.x(), p.y() - cs * c.y(), p.z() - cs * c.z()};
+  std::vector<uint32_t> buckets;
+  for (int oz = -R; oz <= R; ++oz)
+    for (int oy = -R; oy <= R; ++oy)
+      for (int ox = -R; ox <= R; ++ox) {
+        const float gx = slabGap(f[0], ox, cs), gy = slabGap(f[1], oy, cs), gz = slabGap(f[2], oz, cs);
+        if (gx * gx + gy * gy + gz * gz < reach2) buckets.push_back(grid.bucketOf(c + Eigen::Vector3i(ox, oy, oz)));
+      }
+  std::sort(buckets.begin(), buckets.end());
+  buckets.erase(std::unique(buckets.begin(), buckets.end()), buckets.end());
+  for (const uint32_t b : buckets)
+    if (grid.cellStart[b] != grid.cellStart[b + 1]) ranges.insert(ranges.end(), {grid.cellStart[b], grid.cellStart[b + 1]});
+}
+
 }  // namespace
 
 void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
@@ -188,12 +244,141 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
     ph[k] = radius[j];
   });
 
+  // Particles whose support radius exceeds the cell size ("big": drips that grew while they hung, see
+  // neighborCellSize) are searched over every cell within their reach, and the others' candidates
+  // skip them: a big particle's pairs come from its own search and are handed to its neighbours'
+  // lists. One grown drip no longer makes every particle search cells of its size.
+  std::vector<uint32_t>& big = lists.big;
+  big.clear();
+  float hMax = 0.0f;
+  for (size_t i = 0; i < n; ++i) {
+    hMax = std::max(hMax, radius[i]);
+    if (radius[i] > cs) big.push_back(static_cast<uint32_t>(i));
+  }
+
+  // the neighbours of i among the candidates of ranges [ranges[2r], ranges[2r + 1]) of the entries,
+  // cloth ones to cl[nCloth ..) and water ones to wa[nWater ..), in candidate order. Candidates with
+  // a radius above `cutoff` are skipped. Branch free: every candidate is written, the cursor advances
+  // only for neighbours.
+  const auto scan = [&](size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
+                        std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) {
+    const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
+    uint32_t ncl = nCloth, nwa = nWater;
+    // locals, not the closure's references: the vector stores below may alias anything, and GCC would
+    // load every pointer again after each of them
+    const float* const PX = px;
+    const float* const PY = py;
+    const float* const PZ = pz;
+    const float* const PH = ph;
+    const uint32_t* const E = entries;
+    for (int r = 0; r < count; ++r) {
+      const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
+      if (ncl + (k1 - k0) + 16 > cl.size()) cl.resize(2 * (ncl + (k1 - k0) + 16));  // + 16: whole-vector stores
+      if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));
+      uint32_t* pc = cl.data();
+      uint32_t* pw = wa.data();
+      uint32_t k = k0;
+#if defined(__AVX512F__)
+      // 16 candidates at a time; the neighbours are compressed into the lists in candidate order,
+      // so the lists are the same as the scalar loop's
+      const __m512 vx = _mm512_set1_ps(xi), vy = _mm512_set1_ps(yi), vz = _mm512_set1_ps(zi);
+      const __m512 vh = _mm512_set1_ps(hi), half = _mm512_set1_ps(0.5f), vcut = _mm512_set1_ps(cutoff);
+      const __m512i self = _mm512_set1_epi32(static_cast<int>(i)), split = _mm512_set1_epi32(static_cast<int>(firstWater));
+      for (; k < k1; k += 16) {
+        const __mmask16 lanes = k1 - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (k1 - k)) - 1u);
+        const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, PX + k));
+        const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, PY + k));
+        const __m512 dz = _mm512_sub_ps(vz, _mm512_maskz_loadu_ps(lanes, PZ + k));
+        const __m512 hj = _mm512_maskz_loadu_ps(lanes, PH + k);
+        const __m512 h = _mm512_mul_ps(half, _mm512_add_ps(vh, hj));
+        // (dx^2 + dy^2) + dz^2, rounded as the scalar expression (no FMA)
+        const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
+        const __m512i j = _mm512_maskz_loadu_epi32(lanes, E + k);
+        const __mmask16 in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(h, h), _CMP_LT_OQ) &
+                             _mm512_cmp_ps_mask(hj, vcut, _CMP_LE_OQ) & _mm512_cmpneq_epi32_mask(j, self);
+        const __mmask16 isCloth = _mm512_cmplt_epu32_mask(j, split);
+        const __mmask16 inCloth = in & isCloth, inWater = in & static_cast<__mmask16>(~isCloth);
+        // compress in a register and store all 16 lanes (the lists have room): a compressing store
+        // to memory is microcoded and slow on AMD Zen 4
+        _mm512_storeu_si512(pc + ncl, _mm512_maskz_compress_epi32(inCloth, j));
+        _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(inWater, j));
+        ncl += static_cast<uint32_t>(__builtin_popcount(inCloth));
+        nwa += static_cast<uint32_t>(__builtin_popcount(inWater));
+      }
+#else
+      for (; k < k1; ++k) {
+        const float dx = xi - PX[k], dy = yi - PY[k], dz = zi - PZ[k];
+        const float h = 0.5f * (hi + PH[k]);
+        const uint32_t j = E[k];
+        const uint32_t in = (dx * dx + dy * dy + dz * dz < h * h) & (PH[k] <= cutoff) & (j != static_cast<uint32_t>(i));
+        const uint32_t isCloth = j < firstWater;
+        pc[ncl] = j;
+        pw[nwa] = j;
+        ncl += in & isCloth;
+        nwa += in & (isCloth ^ 1u);
+      }
+#endif
+    }
+    nCloth = ncl;
+    nWater = nwa;
+  };
+
+  // each big particle's list (cloth part first), from every cell within (h_i + hMax) / 2, all candidates
+  std::vector<std::vector<uint32_t>>& bigLists = lists.bigLists;
+  std::vector<uint32_t>& bigCloth = lists.bigCloth;
+  bigLists.resize(big.size());
+  bigCloth.resize(big.size());
+  if (!big.empty()) {
+#pragma omp parallel if (parallel && big.size() > 1)
+    {
+      std::vector<uint32_t> ranges, cl(256), wa(256);
+#pragma omp for schedule(dynamic, 1)
+      for (int64_t b = 0; b < static_cast<int64_t>(big.size()); ++b) {
+        const size_t i = big[static_cast<size_t>(b)];
+        wideRanges(grid, lists, dense, x[i], cs, 0.5f * (radius[i] + hMax) * 1.001f, ranges);  // margin for rounding
+        uint32_t ncl = 0, nwa = 0;
+        scan(i, ranges.data(), static_cast<int>(ranges.size() / 2), std::numeric_limits<float>::infinity(), cl, wa, ncl, nwa);
+        std::vector<uint32_t>& out = bigLists[static_cast<size_t>(b)];
+        out.assign(cl.data(), cl.data() + ncl);
+        out.insert(out.end(), wa.data(), wa.data() + nwa);
+        bigCloth[static_cast<size_t>(b)] = ncl;
+      }
+    }
+  }
+  // the big neighbours of every other particle, by ascending index: the lists above turned around
+  std::vector<uint32_t>& extraStart = lists.bigOfStart;
+  std::vector<uint32_t>& extra = lists.bigOf;
+  extraStart.clear();
+  extra.clear();
+  if (!big.empty()) {
+    extraStart.assign(n + 1, 0);
+    for (size_t b = 0; b < big.size(); ++b)
+      for (const uint32_t j : bigLists[b])
+        if (radius[j] <= cs) ++extraStart[j + 1];
+    for (size_t i = 0; i < n; ++i) extraStart[i + 1] += extraStart[i];
+    extra.resize(extraStart[n]);
+    std::vector<uint32_t> cursor(extraStart.begin(), extraStart.end() - 1);
+    for (size_t b = 0; b < big.size(); ++b)
+      for (const uint32_t j : bigLists[b])
+        if (radius[j] <= cs) extra[cursor[j]++] = big[b];
+  }
+
   // the neighbours of i, cloth ones to cl[0 .. nCloth) and water ones to wa[0 .. nWater), in a
-  // fixed order. Branch free: every candidate is written, the cursor advances only for neighbours.
-  // Cells the particle's reach does not touch are skipped.
+  // fixed order. Cells the particle's reach does not touch are skipped.
   const auto gather = [&](size_t i, RangeCache& cache, std::vector<uint32_t>& cl, std::vector<uint32_t>& wa,
                           uint32_t& nCloth, uint32_t& nWater) {
     const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
+    if (hi > cs) {  // a big particle: its list is made
+      const size_t b = static_cast<size_t>(std::lower_bound(big.begin(), big.end(), static_cast<uint32_t>(i)) - big.begin());
+      const std::vector<uint32_t>& own = bigLists[b];
+      nCloth = bigCloth[b];
+      nWater = static_cast<uint32_t>(own.size()) - nCloth;
+      if (nCloth > cl.size()) cl.resize(nCloth);
+      if (nWater > wa.size()) wa.resize(nWater);
+      std::copy(own.begin(), own.begin() + nCloth, cl.begin());
+      std::copy(own.begin() + nCloth, own.end(), wa.begin());
+      return;
+    }
     const float reach = 0.5f * (hi + cs) * 1.001f, reach2 = reach * reach;  // margin for rounding
     uint32_t ranges[27][2];
     int count = 0;
@@ -210,63 +395,17 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
         ++count;
       }
     }
-    uint32_t ncl = 0, nwa = 0;
-    // locals, not the closure's references: the vector stores below may alias anything, and GCC would
-    // load every pointer again after each of them
-    const float* const PX = px;
-    const float* const PY = py;
-    const float* const PZ = pz;
-    const float* const PH = ph;
-    const uint32_t* const E = entries;
-    for (int r = 0; r < count; ++r) {
-      const uint32_t k0 = ranges[r][0], k1 = ranges[r][1];
-      if (ncl + (k1 - k0) + 16 > cl.size()) cl.resize(2 * (ncl + (k1 - k0) + 16));  // + 16: whole-vector stores
-      if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));
-      uint32_t* pc = cl.data();
-      uint32_t* pw = wa.data();
-      uint32_t k = k0;
-#if defined(__AVX512F__)
-      // 16 candidates at a time; the neighbours are compressed into the lists in candidate order,
-      // so the lists are the same as the scalar loop's
-      const __m512 vx = _mm512_set1_ps(xi), vy = _mm512_set1_ps(yi), vz = _mm512_set1_ps(zi);
-      const __m512 vh = _mm512_set1_ps(hi), half = _mm512_set1_ps(0.5f);
-      const __m512i self = _mm512_set1_epi32(static_cast<int>(i)), split = _mm512_set1_epi32(static_cast<int>(firstWater));
-      for (; k < k1; k += 16) {
-        const __mmask16 lanes = k1 - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (k1 - k)) - 1u);
-        const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, PX + k));
-        const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, PY + k));
-        const __m512 dz = _mm512_sub_ps(vz, _mm512_maskz_loadu_ps(lanes, PZ + k));
-        const __m512 h = _mm512_mul_ps(half, _mm512_add_ps(vh, _mm512_maskz_loadu_ps(lanes, PH + k)));
-        // (dx^2 + dy^2) + dz^2, rounded as the scalar expression (no FMA)
-        const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
-        const __m512i j = _mm512_maskz_loadu_epi32(lanes, E + k);
-        const __mmask16 in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(h, h), _CMP_LT_OQ) &
-                             _mm512_cmpneq_epi32_mask(j, self);
-        const __mmask16 isCloth = _mm512_cmplt_epu32_mask(j, split);
-        const __mmask16 inCloth = in & isCloth, inWater = in & static_cast<__mmask16>(~isCloth);
-        // compress in a register and store all 16 lanes (the lists have room): a compressing store
-        // to memory is microcoded and slow on AMD Zen 4
-        _mm512_storeu_si512(pc + ncl, _mm512_maskz_compress_epi32(inCloth, j));
-        _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(inWater, j));
-        ncl += static_cast<uint32_t>(__builtin_popcount(inCloth));
-        nwa += static_cast<uint32_t>(__builtin_popcount(inWater));
-      }
-#else
-      for (; k < k1; ++k) {
-        const float dx = xi - PX[k], dy = yi - PY[k], dz = zi - PZ[k];
-        const float h = 0.5f * (hi + PH[k]);
-        const uint32_t j = E[k];
-        const uint32_t in = (dx * dx + dy * dy + dz * dz < h * h) & (j != static_cast<uint32_t>(i));
-        const uint32_t isCloth = j < firstWater;
-        pc[ncl] = j;
-        pw[nwa] = j;
-        ncl += in & isCloth;
-        nwa += in & (isCloth ^ 1u);
-      }
-#endif
+    nCloth = nWater = 0;
+    scan(i, &ranges[0][0], count, cs, cl, wa, nCloth, nWater);
+    if (extra.empty()) return;
+    // then its big neighbours, after the others of its kind
+    for (uint32_t e = extraStart[i]; e < extraStart[i + 1]; ++e) {
+      const uint32_t j = extra[e];
+      std::vector<uint32_t>& to = j < firstWater ? cl : wa;
+      uint32_t& at = j < firstWater ? nCloth : nWater;
+      if (at + 1 > to.size()) to.resize(2 * (at + 1));
+      to[at++] = j;
     }
-    nCloth = ncl;
-    nWater = nwa;
   };
 
   // room for the lists: last build's total and an eighth (exact on the first build, from a count

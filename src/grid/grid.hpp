@@ -2,6 +2,7 @@
 // every step without allocation after warm-up, and per-particle neighbour lists built from it (from a
 // dense grid of the particles' bounding box with the same cells when that is small enough: the cells
 // of a row are then one range). Two particles are neighbours when |x_i - x_j| < h_ij = (h_i + h_j) / 2 (per-particle radii).
+// The cell size need not be the largest radius: the few particles above it are searched wider.
 #pragma once
 #include <soak/math.hpp>
 
@@ -78,6 +79,14 @@ struct NeighborLists {
   Vec3 denseOrigin = Vec3::Zero();
   Eigen::Vector3i denseDims{0, 0, 0};
   std::vector<uint32_t> denseStart, denseEntries, denseCell;
+  // the particles whose support radius exceeds the grid's cell size ("big", ascending); their pairs
+  // come from a search of every cell within their reach (buildNeighborLists). Callers that look up
+  // the grid's 27 cells themselves must add these (emission's drip density)
+  std::vector<uint32_t> big;
+  // scratch of the build: each big particle's list (cloth part first, bigCloth entries) and, turned
+  // around, the big neighbours of every other particle i: bigOf[bigOfStart[i] .. bigOfStart[i + 1])
+  std::vector<std::vector<uint32_t>> bigLists;
+  std::vector<uint32_t> bigCloth, bigOfStart, bigOf;
   uint32_t count(size_t i) const { return start[i + 1] - start[i]; }
   // the cloth neighbours of i when the lists were built with firstWater = numCloth, else all
   uint32_t clothEnd(size_t i, uint32_t numCloth) const { return firstWater == numCloth ? mid[i] : start[i + 1]; }
@@ -89,7 +98,9 @@ struct NeighborLists {
 void buildGrid(const std::vector<Vec3>& x, float cellSize, NeighborGrid& grid);
 
 // neighbour lists for every particle from a grid built on the same positions; in each list the
-// neighbours with index < firstWater (cloth) come before the others (water)
+// neighbours with index < firstWater (cloth) come before the others (water). Particles with a radius
+// above the grid's cell size are found by their own wider search and come last in the others' lists
+// (of their kind)
 void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
                         NeighborLists& lists, uint32_t firstWater = 0);
 

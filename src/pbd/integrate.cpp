@@ -71,6 +71,16 @@ float maxSupportRadius(const Particles& p) {
   return h;
 }
 
+float neighborCellSize(const Model& model, const Particles& p) {
+  const size_t nc = std::min(static_cast<size_t>(std::max(model.numCloth, 0)), p.size());
+  float h = std::max(1e-3f, model.water.supportRadius), hMax = h;
+  for (size_t i = 0; i < nc; ++i) h = std::max(h, p.radius[i]);
+  size_t above = 0;
+  for (size_t i = nc; i < p.size(); ++i)
+    if (p.radius[i] > h) ++above, hMax = std::max(hMax, p.radius[i]);
+  return above * 8 > p.size() ? hMax : h;
+}
+
 float maxSpeed(const Particles& p) {
   float m = 0.0f;
   for (const Vec3& v : p.v) m = std::max(m, v.norm());

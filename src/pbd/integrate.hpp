@@ -24,6 +24,13 @@ size_t removeOutsideDomain(const Model& model, State& state, std::vector<uint8_t
 
 void updateColliderPoses(const Model& model, double time, std::vector<ColliderPose>& poses);
 float maxSupportRadius(const Particles& p);
+
+// the neighbour grid's cell size: the largest support radius of the cloth particles and of water as
+// emitted (water.supportRadius). The few particles above it (drips that grew while they hung, up to
+// 3 times as wide in Fig. 9) are searched wider by buildNeighborLists instead of making every cell
+// their size; when more than an eighth of the particles are above it (heavy rain drops), the largest
+// radius of all
+float neighborCellSize(const Model& model, const Particles& p);
 float maxSpeed(const Particles& p);
 float meanDensityRatio(const Model& model, const Particles& p, const FluidScratch& s);
 

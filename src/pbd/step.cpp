@@ -40,7 +40,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
   ms.predict += clock.lap();
   solveGarments(model, state, ws.garment, ws.poses, h, stats);                      // Chen 2012: Eq. 1-5, 15-19, 3.5
   ms.garment += clock.lap();
-  buildGrid(p.xPred, maxSupportRadius(p), ws.grid);                                 // neighbours of x*
+  buildGrid(p.xPred, neighborCellSize(model, p), ws.grid);                         // neighbours of x*
   buildNeighborLists(p.xPred, p.radius, ws.grid, ws.neighbors, static_cast<uint32_t>(model.numCloth));
   ms.neighbors += clock.lap();
   computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary

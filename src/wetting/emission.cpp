@@ -43,9 +43,10 @@ Vec3 vertexNormal(const Model& model, const std::vector<Vec3>& x, int64_t i) {
 }
 
 // SPH density a drip of mass m and radius hp would have at y: itself, the water and the cloth as
-// Akinci boundary particles (Psi_b = rho0 V_b), the drips made in this stage included
+// Akinci boundary particles (Psi_b = rho0 V_b), the drips made in this stage included. big: the
+// particles wider than the grid's cells (NeighborLists::big), which its 27 cells may not reach
 float dripDensity(const Model& model, const Particles& p, const NeighborGrid& grid, size_t gridSize,
-                  const WettingScratch& s, const Vec3& y, float m, float hp) {
+                  const std::vector<uint32_t>& big, const WettingScratch& s, const Vec3& y, float m, float hp) {
   const int64_t nc = model.numCloth;
   const float rho0 = model.water.restDensity;
   float rho = m * poly6(0.0f, hp);
@@ -56,7 +57,10 @@ float dripDensity(const Model& model, const Particles& p, const NeighborGrid& gr
     const float mj = static_cast<int64_t>(j) < nc ? rho0 * s.volume[j] : p.mass[j];
     rho += mj * poly6(r2, hij);
   };
-  grid.forEachCandidate(y, [&](uint32_t j) { add(j); });
+  grid.forEachCandidate(y, [&](uint32_t j) {
+    if (!std::binary_search(big.begin(), big.end(), j)) add(j);  // each big one once, below
+  });
+  for (const uint32_t j : big) add(j);
   for (size_t j = gridSize; j < p.size(); ++j) add(j);
   return rho;
 }
@@ -274,7 +278,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       if (placed || !dir.allFinite() || dir.squaredNorm() < 0.5f) continue;
       for (int k = 1; k <= 6 && !placed; ++k) {
         y = p.x[i] + (0.25f * static_cast<float>(k) * hDrip) * dir;
-        placed = dripDensity(model, p, grid, gridSize, s, y, mDrip, hDrip) <= rho0;
+        placed = dripDensity(model, p, grid, gridSize, nb.big, s, y, mDrip, hDrip) <= rho0;
       }
     }
     if (!placed) continue;  // crowded: try again at the next wetting pass

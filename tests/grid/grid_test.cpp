@@ -68,6 +68,53 @@ TEST_P(GridVsBruteForce, SameNeighbours) {
 INSTANTIATE_TEST_SUITE_P(Grid, GridVsBruteForce,
                          ::testing::Combine(::testing::Bool(), ::testing::Values(1u, 2u, 3u), ::testing::Bool()));
 
+// particles wider than the grid's cells (drips that grew while they hung: neighborCellSize keeps the
+// cells at the common radius) are found by their own wider search and handed to the others' lists:
+// the same neighbours as brute force, on the dense and the hashed grid, cloth part first, for any
+// thread count, even with big particles touching each other and sitting in the cloth part
+class GridWithBigParticles : public ::testing::TestWithParam<bool> {};
+
+TEST_P(GridWithBigParticles, SameNeighboursAsBruteForce) {
+  const bool far = GetParam();
+  std::vector<Vec3> x;
+  std::vector<float> r;
+  randomSet(4000, 0.25f, true, 23, x, r);
+  if (far)
+    for (int k = 0; k < 200; ++k) x[k] += Vec3(37.0f, -12.0f, 5.0f);
+  const float cell = 0.04f;
+  std::vector<uint32_t> big;
+  for (uint32_t k : {5u, 17u, 1200u, 1201u, 2500u, 2501u, 3999u}) {  // 5 and 17: in the cloth part
+    r[k] = k % 2 ? 0.13f : 0.07f;
+    big.push_back(k);
+  }
+  x[2501] = x[2500] + Vec3(0.095f, 0.0f, 0.0f);  // two big ones apart by more than a cell, less than (h + h) / 2
+  const uint32_t firstWater = 1000;
+  const auto ref = bruteForce(x, r);
+  NeighborLists l[2];
+  for (int t = 0; t < 2; ++t) {
+    NeighborGrid grid;
+    setThreadCount(t + 1);
+    buildGrid(x, cell, grid);
+    buildNeighborLists(x, r, grid, l[t], firstWater);
+    setThreadCount(2);
+    EXPECT_EQ(l[t].dense, !far);
+    EXPECT_EQ(l[t].big, big);
+  }
+  EXPECT_EQ(l[0].start, l[1].start);
+  EXPECT_EQ(l[0].mid, l[1].mid);
+  EXPECT_EQ(l[0].index, l[1].index);
+  size_t withBig = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    ASSERT_EQ(sortedNeighbours(l[0], i), ref[i]) << "particle " << i;
+    for (uint32_t k = l[0].start[i]; k < l[0].mid[i]; ++k) ASSERT_LT(l[0].index[k], firstWater);
+    for (uint32_t k = l[0].mid[i]; k < l[0].start[i + 1]; ++k) ASSERT_GE(l[0].index[k], firstWater);
+    for (uint32_t j : ref[i]) withBig += r[j] > cell;
+  }
+  EXPECT_GT(withBig, 100u);  // the big ones have many neighbours the common cells would miss
+}
+
+INSTANTIATE_TEST_SUITE_P(Grid, GridWithBigParticles, ::testing::Bool());
+
 // grid and lists of x built on `threads` threads, cloth before water at `split`
 NeighborLists listsOn(int threads, const std::vector<Vec3>& x, const std::vector<float>& r, uint32_t split) {
   NeighborGrid g;

@@ -2,6 +2,7 @@
 #include "support/run_scene.hpp"
 
 #include "pbd/coupling.hpp"
+#include "pbd/integrate.hpp"
 
 #include <gtest/gtest.h>
 
@@ -252,4 +253,25 @@ TEST(Step, BlockOfWaterInFreeFallKeepsItsSize) {
   const float start = extent();
   runSteps(scene, 30);
   EXPECT_LT(extent() - start, 0.5f * scene.model.water.spacing);
+}
+
+// the neighbour grid keeps cells of the common support radius while a few drips grew wider (their
+// pairs come from their own wider search, tests/grid), and takes the largest radius once more than an
+// eighth of the particles are wider (a scene of heavy rain drops)
+TEST(Step, NeighborCellSizeIgnoresAFewGrownDrips) {
+  Scene scene = sceneFromJson(kSmallCubeOnCloth);
+  runSteps(scene, 1);
+  Particles& p = scene.state.particles;
+  const float h0 = scene.model.water.supportRadius;
+  const size_t nc = static_cast<size_t>(scene.model.numCloth), n = p.size();
+  ASSERT_GT(n - nc, 1000u);
+  EXPECT_FLOAT_EQ(neighborCellSize(scene.model, p), h0);
+  for (size_t k = 0; k < 10; ++k) p.radius[nc + 7 * k] = 3.0f * h0;
+  EXPECT_FLOAT_EQ(neighborCellSize(scene.model, p), h0);
+  for (size_t i = nc; i < nc + n / 8 + 1; ++i) p.radius[i] = 1.5f * h0;
+  p.radius[nc] = 3.0f * h0;
+  EXPECT_FLOAT_EQ(neighborCellSize(scene.model, p), 3.0f * h0);
+  // and a step runs with them (the lists themselves: GridWithBigParticles)
+  runSteps(scene, 1);
+  EXPECT_TRUE(checkState(scene.model, scene.state).empty());
 }
