@@ -119,15 +119,23 @@ bool buildDenseCells(const std::vector<Vec3>& x, float cs, NeighborLists& lists)
   return true;
 }
 
+// the dense grid's cell of a point p (clamped to the grid) and p's place inside it (0 .. cs a side)
+void denseCellOf(const NeighborLists& lists, const Vec3& p, float cs, int cell[3], float f[3]) {
+  const Eigen::Vector3i& d = lists.denseDims;
+  const Vec3 c = (p - lists.denseOrigin) / cs;
+  for (int a = 0; a < 3; ++a) {
+    cell[a] = std::min(static_cast<int>(c[a]), d[a] - 1);
+    f[a] = p[a] - (lists.denseOrigin[a] + cs * cell[a]);
+  }
+}
+
 // the candidates of a particle at p in the dense grid: for each of the 9 rows (y, z) around its cell
 // that its reach touches, the cells x - 1 .. x + 1 it touches as one range of the entries
 int denseRowRanges(const NeighborLists& lists, const Vec3& p, float cs, float reach2, uint32_t (*ranges)[2]) {
   const Eigen::Vector3i& d = lists.denseDims;
-  const Vec3 c = (p - lists.denseOrigin) / cs;
-  const int cell[3] = {std::min(static_cast<int>(c.x()), d.x() - 1), std::min(static_cast<int>(c.y()), d.y() - 1),
-                       std::min(static_cast<int>(c.z()), d.z() - 1)};
-  const float f[3] = {p.x() - (lists.denseOrigin.x() + cs * cell[0]), p.y() - (lists.denseOrigin.y() + cs * cell[1]),
-                      p.z() - (lists.denseOrigin.z() + cs * cell[2])};
+  int cell[3];
+  float f[3];
+  denseCellOf(lists, p, cs, cell, f);
   // squared distance from p to the neighbouring slab at offset o along axis a (0 for its own)
   const auto gap2 = [&](int a, int o) {
     const float g = o < 0 ? f[a] : (o > 0 ? cs - f[a] : 0.0f);
@@ -172,11 +180,9 @@ void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense
   const int R = static_cast<int>(std::ceil(reach / cs));
   if (dense) {
     const Eigen::Vector3i& d = lists.denseDims;
-    const Vec3 c = (p - lists.denseOrigin) / cs;
-    const int cell[3] = {std::min(static_cast<int>(c.x()), d.x() - 1), std::min(static_cast<int>(c.y()), d.y() - 1),
-                         std::min(static_cast<int>(c.z()), d.z() - 1)};
-    const float f[3] = {p.x() - (lists.denseOrigin.x() + cs * cell[0]), p.y() - (lists.denseOrigin.y() + cs * cell[1]),
-                        p.z() - (lists.denseOrigin.z() + cs * cell[2])};
+    int cell[3];
+    float f[3];
+    denseCellOf(lists, p, cs, cell, f);
     for (int oz = -R; oz <= R; ++oz) {
       const int z = cell[2] + oz;
       if (z < 0 || z >= d.z()) continue;
