@@ -201,6 +201,11 @@ void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense
     }
     return;
   }
+  // more cells than buckets: every bucket is in reach, the whole table is the one range
+  if (std::pow(2.0 * R + 1.0, 3.0) > static_cast<double>(grid.tableMask) + 1.0) {
+    if (!grid.cellEntries.empty()) ranges.insert(ranges.end(), {0u, static_cast<uint32_t>(grid.cellEntries.size())});
+    return;
+  }
   const Eigen::Vector3i c = grid.cellOf(p);
   const float f[3] = {p.x() - cs * c.x(), p.y() - cs * c.y(), p.z() - cs * c.z()};
   std::vector<uint32_t> buckets;
