@@ -146,7 +146,9 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   const float dt = model.solver.dt;
   WorkspacePtr ws = makeWorkspace();
   const int steps = job.wholeRun ? scene.output.frames * scene.output.stepsPerFrame : job.steps;
-  if (steps < 1) throw Error(job.scene + ": --whole-run: the scene's output.frames x stepsPerFrame is no step");
+  if (steps < 1)
+    throw Error(job.scene + ": --whole-run needs at least one step (output.frames x output.stepsPerFrame is " +
+                std::to_string(steps) + ")");
   if (!quiet) std::fprintf(stderr, "soak bench: %s: %d warm-up steps, %d timed steps%s\n", job.name.c_str(), job.warmup,
                            steps, job.wholeRun ? " (the whole run)" : "");
   for (int s = 0; s < job.warmup; ++s) {
