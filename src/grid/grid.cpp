@@ -172,9 +172,9 @@ inline float slabGap(float f, int o, float cs) {
 // the candidates of a particle at p whose reach spans more than one cell (a support radius above the
 // cell size: `buildNeighborLists`): every cell within `reach` of p, as ranges of the entries, in a
 // fixed order. Dense grid: one range per row (y, z) for the cells of the row it touches; hashed grid:
-// one range per bucket, each bucket once
+// one range per bucket, each bucket once (buckets: the caller's scratch)
 void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense, const Vec3& p, float cs, float reach,
-                std::vector<uint32_t>& ranges) {  // [begin, end) pairs, flat
+                std::vector<uint32_t>& ranges, std::vector<uint32_t>& buckets) {  // ranges: [begin, end) pairs, flat
   ranges.clear();
   const float reach2 = reach * reach;
   const int R = static_cast<int>(std::ceil(reach / cs));
@@ -208,7 +208,7 @@ void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense
   }
   const Eigen::Vector3i c = grid.cellOf(p);
   const float f[3] = {p.x() - cs * c.x(), p.y() - cs * c.y(), p.z() - cs * c.z()};
-  std::vector<uint32_t> buckets;
+  buckets.clear();
   for (int oz = -R; oz <= R; ++oz)
     for (int oy = -R; oy <= R; ++oy)
       for (int ox = -R; ox <= R; ++ox) {
@@ -342,11 +342,11 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   if (!big.empty()) {
 #pragma omp parallel if (parallel && big.size() > 1)
     {
-      std::vector<uint32_t> ranges, cl(256), wa(256);
+      std::vector<uint32_t> ranges, buckets, cl(256), wa(256);
 #pragma omp for schedule(dynamic, 1)
       for (int64_t b = 0; b < static_cast<int64_t>(big.size()); ++b) {
         const size_t i = big[static_cast<size_t>(b)];
-        wideRanges(grid, lists, dense, x[i], cs, 0.5f * (radius[i] + hMax) * 1.001f, ranges);  // margin for rounding
+        wideRanges(grid, lists, dense, x[i], cs, 0.5f * (radius[i] + hMax) * 1.001f, ranges, buckets);  // margin for rounding
         uint32_t ncl = 0, nwa = 0;
         scan(i, ranges.data(), static_cast<int>(ranges.size() / 2), std::numeric_limits<float>::infinity(), cl, wa, ncl, nwa);
         std::vector<uint32_t>& out = bigLists[static_cast<size_t>(b)];
