@@ -374,7 +374,8 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   s.candidateSide.resize(s.candidates.size());
   s.particleSide.resize(static_cast<size_t>(nw));
   s.searchedEnd.resize(static_cast<size_t>(nw));
-  parallelFor(nw, [&](int64_t w) {
+  // dynamic: only the water near the sheet has candidates, and it may sit in one part of the indices
+  parallelForDynamic(nw, kWaterChunk, [&](int64_t w) {
     const Vec3 xq0 = p.x[static_cast<size_t>(nc + w)];
     const uint32_t c0 = s.candidateStart[static_cast<size_t>(w)], c1 = s.candidateStart[static_cast<size_t>(w) + 1];
     const float sheetSide = sheetSideOf(p, s, s.nearestCloth[static_cast<size_t>(w)], xq0);
