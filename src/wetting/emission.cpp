@@ -42,11 +42,12 @@ Vec3 vertexNormal(const Model& model, const std::vector<Vec3>& x, int64_t i) {
   return len > 1e-20f ? Vec3(n / len) : Vec3::Zero();
 }
 
-// SPH density a drip of mass m and radius hp would have at y: itself, the water and the cloth as
-// Akinci boundary particles (Psi_b = rho0 V_b), the drips made in this stage included. big: the
-// particles wider than the grid's cells (NeighborLists::big), which its 27 cells may not reach
-float dripDensity(const Model& model, const Particles& p, const NeighborGrid& grid, size_t gridSize,
-                  const std::vector<uint32_t>& big, const WettingScratch& s, const Vec3& y, float m, float hp) {
+// SPH density a drip of mass m and radius hp would have at y, without the drips made in this stage
+// (indices from gridSize on): itself, the water and the cloth as Akinci boundary particles (Psi_b =
+// rho0 V_b). big: the particles wider than the grid's cells (NeighborLists::big), which its 27 cells
+// may not reach
+float dripDensityBefore(const Model& model, const Particles& p, const NeighborGrid& grid, const std::vector<uint32_t>& big,
+                        const WettingScratch& s, const Vec3& y, float m, float hp) {
   const int64_t nc = model.numCloth;
   const float rho0 = model.water.restDensity;
   float rho = m * poly6(0.0f, hp);
@@ -61,8 +62,29 @@ float dripDensity(const Model& model, const Particles& p, const NeighborGrid& gr
     if (!std::binary_search(big.begin(), big.end(), j)) add(j);  // each big one once, below
   });
   for (const uint32_t j : big) add(j);
-  for (size_t j = gridSize; j < p.size(); ++j) add(j);
   return rho;
+}
+
+// rho (dripDensityBefore at y) plus the drips made in this stage, in index order: the whole density
+float addNewDrips(float rho, const Particles& p, size_t gridSize, const Vec3& y, float hp) {
+  for (size_t j = gridSize; j < p.size(); ++j) {
+    const float hij = pairRadius(hp, p.radius[j]);
+    const float r2 = (y - p.x[j]).squaredNorm();
+    if (r2 < hij * hij) rho += p.mass[j] * poly6(r2, hij);
+  }
+  return rho;
+}
+
+// placement t (0 .. kDripTries - 1) of a drip of radius hp below cloth particle i, whose vertex normal is
+// n: along gravity first, then off the cloth's surface on either side, at 1/4 .. 6/4 hp. False when
+// the direction does not exist (no gravity, a degenerate normal)
+constexpr int kDripTries = 30;
+bool dripPlacement(const Vec3& xi, const Vec3& g, const Vec3& n, float hp, int t, Vec3& y) {
+  const Vec3 dirs[5] = {g, (g + n).normalized(), (g - n).normalized(), n, -n};
+  const Vec3& dir = dirs[t / 6];
+  if (!dir.allFinite() || dir.squaredNorm() < 0.5f) return false;
+  y = xi + (0.25f * static_cast<float>(t % 6 + 1) * hp) * dir;
+  return true;
 }
 
 }  // namespace
@@ -265,28 +287,52 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const size_t gridSize = grid.cellEntries.size();
   const float mDrip = w.massThreshold;
   const float hDrip = std::cbrt(mDrip / m0) * h0;  // h_p = (m_p / m0)^(1/3) h0
-  size_t made = 0;
-  for (int64_t i = 0; i < nc; ++i) {
-    if (dripOf[i] >= 0 || state.clothBuffer[i] < static_cast<double>(mDrip)) continue;
-    if (p.size() >= static_cast<size_t>(model.solver.maxParticles)) break;
-    // below along gravity first, then off the cloth's surface on either side
+  // the sources, in cloth order; then, in parallel, each one's first placement that the density
+  // before this stage's drips allows (a placement it crowds stays crowded: the drips made below only
+  // add density); then, serially in cloth order, the drips made before it are added, and a placement
+  // they crowd moves on to the next ones. The same drips, places and sums as trying every placement
+  // serially, with the density's terms added in the same order
+  std::vector<int32_t>& sources = s.dripSources;
+  sources.clear();
+  for (int64_t i = 0; i < nc; ++i)
+    if (dripOf[i] < 0 && state.clothBuffer[i] >= static_cast<double>(mDrip)) sources.push_back(static_cast<int32_t>(i));
+  const int64_t nSources = static_cast<int64_t>(sources.size());
+  s.dripTry.assign(sources.size(), -1);
+  s.dripBase.assign(sources.size(), 0.0f);
+#pragma omp parallel for schedule(dynamic, 4) if (nSources > 8)
+  for (int64_t c = 0; c < nSources; ++c) {
+    const int32_t i = sources[static_cast<size_t>(c)];
     const Vec3 n = vertexNormal(model, p.x, i);
-    const Vec3 dirs[5] = {g, (g + n).normalized(), (g - n).normalized(), n, -n};
-    bool placed = false;
-    Vec3 y = p.x[i];
-    for (const Vec3& dir : dirs) {
-      if (placed || !dir.allFinite() || dir.squaredNorm() < 0.5f) continue;
-      for (int k = 1; k <= 6 && !placed; ++k) {
-        y = p.x[i] + (0.25f * static_cast<float>(k) * hDrip) * dir;
-        placed = dripDensity(model, p, grid, gridSize, nb.big, s, y, mDrip, hDrip) <= rho0;
+    for (int t = 0; t < kDripTries; ++t) {
+      Vec3 y;
+      if (!dripPlacement(p.x[i], g, n, hDrip, t, y)) continue;
+      const float rho = dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip);
+      if (rho <= rho0) {
+        s.dripTry[static_cast<size_t>(c)] = t;
+        s.dripBase[static_cast<size_t>(c)] = rho;
+        break;
       }
     }
-    if (!placed) continue;  // crowded: try again at the next wetting pass
+  }
+  size_t made = 0;
+  for (int64_t c = 0; c < nSources; ++c) {
+    if (p.size() >= static_cast<size_t>(model.solver.maxParticles)) break;
+    const int32_t i = sources[static_cast<size_t>(c)];
+    int t = s.dripTry[static_cast<size_t>(c)];
+    if (t < 0) continue;  // crowded: try again at the next wetting pass
+    const Vec3 n = vertexNormal(model, p.x, i);
+    Vec3 y;
+    dripPlacement(p.x[i], g, n, hDrip, t, y);
+    bool placed = addNewDrips(s.dripBase[static_cast<size_t>(c)], p, gridSize, y, hDrip) <= rho0;
+    while (!placed && ++t < kDripTries)
+      if (dripPlacement(p.x[i], g, n, hDrip, t, y))
+        placed = addNewDrips(dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip), p, gridSize, y, hDrip) <= rho0;
+    if (!placed) continue;
     const uint32_t id = state.nextId++;
     p.add(kWaterPhase, id, mDrip, hDrip, y, p.v[i]);
     state.clothBuffer[i] -= static_cast<double>(mDrip);
     state.dripId.push_back(id);  // the newest id is the largest: the list stays ascending
-    state.dripSource.push_back(static_cast<int32_t>(i));
+    state.dripSource.push_back(i);
     ++made;
   }
   state.ledger.dripsEmitted += made;

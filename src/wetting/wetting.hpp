@@ -50,6 +50,9 @@ struct WettingScratch {
   std::vector<uint8_t> transfers;  // Eq. 18 holds for the particle
   std::vector<float> outScale;     // keeps a buffer's outflow within the buffer (Eq. 18)
   std::vector<int64_t> dripOf;     // index of the drip hanging from each cloth particle, -1 when none
+  std::vector<int32_t> dripSources;  // cloth particles due a new drip this pass, in cloth order
+  std::vector<int32_t> dripTry;      // per source: its first placement whose density before this pass's drips is at most rho0 (-1: none)
+  std::vector<float> dripBase;       // per source: that density (kg/m^3)
   std::vector<Vec3> force;         // N, sticking force per cloth particle (Eq. 20)
   // geometry of the cloth pairs at this pass's positions x (pairGeometry), one value per entry e of
   // the cloth part [start[i], clothEnd(i)) of a cloth particle i's neighbour list, j = index[e], with

@@ -15,11 +15,12 @@ using namespace soak::testing;
 
 namespace {
 
-// SPH density at particle q: its own mass, the water and the cloth as Akinci boundary (rho0 V_b)
-float densityAt(const Scene& s, const WettingScratch& ws, size_t q) {
+// SPH density at particle q: its own mass, the water and the cloth as Akinci boundary (rho0 V_b);
+// particles from index `upTo` on are left out
+float densityAt(const Scene& s, const WettingScratch& ws, size_t q, size_t upTo = ~size_t(0)) {
   const Particles& p = s.state.particles;
   float rho = p.mass[q] * poly6(0.0f, p.radius[q]);
-  for (size_t j = 0; j < p.size(); ++j) {
+  for (size_t j = 0; j < std::min(upTo, p.size()); ++j) {
     if (j == q) continue;
     const float h = pairRadius(p.radius[q], p.radius[j]);
     const float mj = j < size_t(s.model.numCloth) ? s.model.water.restDensity * ws.volume[j] : p.mass[j];
@@ -73,6 +74,36 @@ TEST(WettingEmission, NoDripBelowTheThresholdOneDripAtIt) {
   EXPECT_NEAR(p.mass[q], 2.25f * thr, 1e-7f);
   EXPECT_NEAR(s.state.clothBuffer[bottom], 0.0, 1e-9);
   EXPECT_NEAR(accountedWater(s), before + thr, 1e-9);
+}
+
+TEST(WettingEmission, DripsMadeInOnePassDoNotCrowdEachOther) {
+  // every particle of the bottom row is due a drip at once: their places are 0.01 m apart and a drip's
+  // support is 0.025 m, so each drip must account for those made before it in the same pass (the
+  // placement is searched in parallel, then settled in cloth order)
+  Scene s = sceneFromJson(R"({"cloth": [)" +
+                          rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.2f, 21, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
+                          R"(], "wetting": {"c": 4e-4}})");  // a 0.01 m cloth holds the 2 g threshold (docs/models.md on c)
+  StageRig rig;
+  rig.refresh(s.state, s.model);
+  const float thr = s.model.wetting.massThreshold;
+  for (size_t c = 0; c < 21; ++c) s.state.clothBuffer[c] = 1.25 * thr;  // row y = 0.9
+  const double before = accountedWater(s);
+  const size_t made = emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, s.model.solver.dt);
+  EXPECT_GE(made, 3u);
+  EXPECT_LE(made, 21u);
+  const Particles& p = s.state.particles;
+  ASSERT_EQ(p.size(), size_t(s.model.numCloth) + made);
+  ASSERT_EQ(s.state.dripSource.size(), made);
+  const float hDrip = std::cbrt(thr / s.model.water.particleMass) * s.model.water.supportRadius;
+  int movedOn = 0;  // drips not at their first place, a quarter of h_p straight below their source
+  for (size_t d = 0; d < made; ++d) {
+    const size_t q = size_t(s.model.numCloth) + d, src = size_t(s.state.dripSource[d]);
+    // when it was made: the drips made before it included (a later one may add to it)
+    EXPECT_LE(densityAt(s, rig.s, q, q + 1), s.model.water.restDensity * 1.001f) << q;
+    movedOn += (p.x[q] - (p.x[src] + Vec3(0, -0.25f * hDrip, 0))).norm() > 1e-6f;
+  }
+  EXPECT_GT(movedOn + int(21 - made), 0);  // the row did crowd itself
+  EXPECT_NEAR(accountedWater(s), before, 1e-12);
 }
 
 TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
