@@ -6,12 +6,35 @@
 
 namespace soak {
 
+namespace {
+
+// the world box of a sphere, capsule or box part at its pose (boundaryParts); planes and meshes keep
+// the infinite one
+void setBounds(BoundaryPart& part) {
+  const Collider& c = part.shape;
+  const Eigen::Matrix3f r = part.pose.rotation.normalized().toRotationMatrix();
+  Vec3 half;
+  switch (c.shape) {
+    case ColliderShape::Sphere: half = Vec3::Constant(c.radius); break;
+    case ColliderShape::Capsule: half = r.col(1).cwiseAbs() * c.halfHeight + Vec3::Constant(c.radius); break;
+    case ColliderShape::Box: half = r.cwiseAbs() * c.halfExtents; break;
+    default: return;
+  }
+  half *= 1.0f + 1e-5f;  // rounding of the rotation against colliderDistance's
+  half += Vec3::Constant(1e-6f);
+  part.lo = part.pose.translation - half;
+  part.hi = part.pose.translation + half;
+}
+
+}  // namespace
+
 void boundaryParts(const Model& model, const std::vector<ColliderPose>& poses, std::vector<BoundaryPart>& parts) {
   parts.clear();
   for (size_t c = 0; c < model.colliders.size(); ++c) {
     const Collider& col = model.colliders[c];
     if (col.shape != ColliderShape::Container) {
       parts.push_back({col, poses[c]});
+      setBounds(parts.back());
       continue;
     }
     // an open container is concave: its walls are separate convex parts
@@ -22,6 +45,7 @@ void boundaryParts(const Model& model, const std::vector<ColliderPose>& poses, s
       part.shape.shape = ColliderShape::Box;
       part.shape.halfExtents = halves[k];
       part.pose.translation = poses[c].translation + poses[c].rotation * centers[k];
+      setBounds(part);
       parts.push_back(part);
     }
   }
@@ -53,6 +77,8 @@ float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, fl
   float empty = 1.0f;  // prod (1 - phi_k)
   Vec3 gradEmpty = Vec3::Zero();
   for (const BoundaryPart& part : parts) {
+    // more than h outside the part's box: d > h, as below (most walls of a container, for most water)
+    if ((x.array() < part.lo.array() - h).any() || (x.array() > part.hi.array() + h).any()) continue;
     Vec3 n;
     const float d = colliderDistance(part.shape, part.pose, x, &n);
     if (d >= h) continue;

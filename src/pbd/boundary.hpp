@@ -7,6 +7,7 @@
 
 #include "world/colliders.hpp"
 
+#include <limits>
 #include <vector>
 
 namespace soak {
@@ -15,6 +16,10 @@ namespace soak {
 struct BoundaryPart {
   Collider shape;
   ColliderPose pose;
+  // a world box that holds the part (infinite for planes and meshes): a point more than h outside it
+  // is farther than h from the part, whose distance then need not be computed
+  Vec3 lo = Vec3::Constant(-std::numeric_limits<float>::infinity());
+  Vec3 hi = Vec3::Constant(std::numeric_limits<float>::infinity());
 };
 
 // the convex parts of every collider at the given poses

@@ -289,3 +289,51 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
     EXPECT_LT(worst, 1e-4f * largest) << (mixed == 0 ? "equal radii" : mixed == 1 ? "mixed radii" : "one shrunk");
   }
 }
+
+TEST(Fluid, BoundaryPartBoxesSkipOnlyPartsBeyondTheSupport) {
+  // boundaryFraction skips a part when the point is more than h outside the part's world box; the
+  // fraction and its gradient must be those of every part measured, for rotated boxes, spheres,
+  // capsules and a tilted container's walls, at points around and inside them
+  Model model;
+  const Quat tilt(Eigen::AngleAxisf(0.6f, Vec3(1, 2, 3).normalized()));
+  Collider box;
+  box.shape = ColliderShape::Box;
+  box.halfExtents = Vec3(0.3f, 0.05f, 0.2f);
+  Collider sphere;
+  sphere.shape = ColliderShape::Sphere;
+  sphere.radius = 0.15f;
+  Collider capsule;
+  capsule.shape = ColliderShape::Capsule;
+  capsule.radius = 0.05f;
+  capsule.halfHeight = 0.2f;
+  Collider container;
+  container.shape = ColliderShape::Container;
+  container.halfExtents = Vec3(0.25f, 0.15f, 0.2f);
+  container.wallThickness = 0.04f;
+  model.colliders = {box, sphere, capsule, container};
+  std::vector<ColliderPose> poses(4);
+  const Vec3 at[4] = {Vec3(0, 0, 0), Vec3(0.4f, 0.1f, 0), Vec3(-0.4f, 0, 0.2f), Vec3(0, -0.5f, 0.1f)};
+  for (int c = 0; c < 4; ++c) poses[c].translation = at[c], poses[c].rotation = tilt;
+  std::vector<BoundaryPart> parts, unbounded;
+  boundaryParts(model, poses, parts);
+  ASSERT_EQ(parts.size(), 3u + 5u);
+  unbounded = parts;
+  for (BoundaryPart& part : unbounded)
+    part.lo = Vec3::Constant(-std::numeric_limits<float>::infinity()), part.hi = -part.lo;
+  const float h = 0.04f;
+  int near = 0, skipped = 0;
+  uint32_t seed = 12345u;
+  const auto uniform = [&] { return (seed = seed * 1664525u + 1013904223u) / 4294967296.0f; };
+  for (int k = 0; k < 20000; ++k) {
+    const Vec3 x(1.4f * uniform() - 0.7f, 1.2f * uniform() - 0.8f, 1.0f * uniform() - 0.4f);
+    Vec3 g, gRef;
+    const float phi = boundaryFraction(parts, x, h, &g), phiRef = boundaryFraction(unbounded, x, h, &gRef);
+    EXPECT_EQ(phi, phiRef) << x.transpose();
+    EXPECT_EQ(g, gRef) << x.transpose();
+    near += phiRef > 0.0f;
+    for (const BoundaryPart& part : parts)
+      skipped += (x.array() < part.lo.array() - h).any() || (x.array() > part.hi.array() + h).any();
+  }
+  EXPECT_GT(near, 1000);         // points by the parts
+  EXPECT_GT(skipped, 20000 * 4); // and most parts skipped for most points
+}
