@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <omp.h>
+
 namespace soak {
 
 namespace {
@@ -104,32 +106,85 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     s.waterLost[j] = static_cast<double>(before) - static_cast<double>(after);  // exact: both are floats
   });
   // 4. the cloth gains in a fixed order (water ascending, neighbours in list order): each water
-  // particle's loss split over its absorbers by their share, the last taking the remainder exactly
-  size_t whole = 0;
-  for (int64_t j = nc; j < n; ++j) {
+  // particle's loss split over its absorbers by their share, the last taking the remainder exactly.
+  // The shares in parallel per water particle; then each cloth particle takes its gains in ascending
+  // water order, the order of a serial loop over the water, in parallel per cloth particle: a gain
+  // changes only its own cloth particle, so no sum depends on the thread count
+  const int64_t nw = n - nc;
+  s.lostStart.resize(static_cast<size_t>(nw) + 1);
+  s.lostStart[0] = 0;
+  for (int64_t k = 0; k < nw; ++k)
+    s.lostStart[k + 1] = s.lostStart[k] + (s.waterLost[nc + k] > 0.0 ? nb.clothEnd(nc + k, cloth) - nb.start[nc + k] : 0u);
+  s.gain.resize(s.lostStart[nw]);
+  s.absorber.resize(s.lostStart[nw]);
+  parallelFor(nw, [&](int64_t k) {
+    const int64_t j = nc + k;
     const double lost = s.waterLost[j];
-    if (lost <= 0.0) continue;
-    whole += s.keep[j] ? 0 : 1;
+    if (lost <= 0.0) return;
+    const uint32_t e0 = nb.start[j], e1 = nb.clothEnd(j, cloth);  // the cloth part
+    double* const gain = s.gain.data() + s.lostStart[k];
+    uint8_t* const takes = s.absorber.data() + s.lostStart[k];
     double shares = 0.0;
     int64_t last = -1;
-    for (uint32_t e = nb.start[j], end = nb.clothEnd(j, cloth); e < end; ++e) {  // the cloth part
+    for (uint32_t e = e0; e < e1; ++e) {
       const int64_t i = nb.index[e];
-      if (i >= nc) continue;
-      const double t = static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j);
-      if (t > 0.0) {
-        shares += t;
-        last = i;
-      }
+      const double t = i < nc ? static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j) : 0.0;
+      gain[e - e0] = t;  // the share for now
+      takes[e - e0] = t > 0.0;
+      if (t > 0.0) shares += t, last = i;
     }
-    if (last < 0) continue;  // unreachable: a loss needs an absorber
     double given = 0.0;
-    for (uint32_t e = nb.start[j], end = nb.clothEnd(j, cloth); e < end; ++e) {  // the cloth part
-      const int64_t i = nb.index[e];
-      if (i >= nc) continue;
-      const double t = static_cast<double>(s.clothScale[i]) * s.waterScale[j] * request(i, j);
-      if (t <= 0.0) continue;
-      const double gain = i == last ? lost - given : lost * (t / shares);
-      given += gain;
+    for (uint32_t e = e0; e < e1; ++e) {
+      if (!takes[e - e0]) continue;
+      const double g = static_cast<int64_t>(nb.index[e]) == last ? lost - given : lost * (gain[e - e0] / shares);
+      given += g;
+      gain[e - e0] = g;
+    }
+  });
+  // the slots by cloth particle, water ascending: counted and placed per thread over a contiguous
+  // range of the water, the ranges in thread order
+  const int threads = threadCount();
+  const size_t stride = static_cast<size_t>(nc) + 1;
+  s.gainStart.assign(stride * static_cast<size_t>(threads), 0);
+  std::vector<uint32_t> first(stride, 0);
+#pragma omp parallel num_threads(threads) if (s.lostStart[nw] >= 512)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const int64_t kb = nw * t / nt, ke = nw * (t + 1) / nt;
+    uint32_t* const at = s.gainStart.data() + stride * static_cast<size_t>(t);
+    const auto forSlots = [&](auto&& f) {
+      for (int64_t k = kb; k < ke; ++k)
+        for (uint32_t c = s.lostStart[k], c1 = s.lostStart[k + 1], e = nb.start[nc + k]; c < c1; ++c, ++e)
+          if (s.absorber[c]) f(nb.index[e], c, static_cast<uint32_t>(nc + k));
+    };
+    forSlots([&](uint32_t i, uint32_t, uint32_t) { ++at[i]; });
+#pragma omp barrier
+#pragma omp single
+    {
+      uint32_t sum = 0;  // thread u's first slot of cloth particle i: after those of i's lower threads
+      for (int64_t i = 0; i < nc; ++i) {
+        first[static_cast<size_t>(i)] = sum;
+        for (int u = 0; u < nt; ++u) {
+          uint32_t& c = s.gainStart[stride * static_cast<size_t>(u) + static_cast<size_t>(i)];
+          const uint32_t count = c;
+          c = sum;
+          sum += count;
+        }
+      }
+      first[static_cast<size_t>(nc)] = sum;
+      s.gainSlot.resize(sum);
+      s.gainWater.resize(sum);
+    }
+    forSlots([&](uint32_t i, uint32_t c, uint32_t j) {
+      const uint32_t to = at[i]++;
+      s.gainSlot[to] = c;
+      s.gainWater[to] = j;
+    });
+  }
+  parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
+    for (uint32_t g = first[static_cast<size_t>(i)]; g < first[static_cast<size_t>(i) + 1]; ++g) {
+      const double gain = s.gain[s.gainSlot[g]];
+      const uint32_t j = s.gainWater[g];
       state.clothWater[i] += gain;
       // the absorbed water brings its momentum (inelastic: the cloth particle gets heavier)
       const float mi = p.mass[i], dm = static_cast<float>(gain);
@@ -139,7 +194,9 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       }
       p.mass[i] = mi + dm;
     }
-  }
+  });
+  size_t whole = 0;
+  for (int64_t j = nc; j < n; ++j) whole += s.waterLost[j] > 0.0 && !s.keep[j] ? 1 : 0;
   s.anyAbsorbedWhole = whole > 0;
   state.ledger.particlesAbsorbed += whole;
   return whole;

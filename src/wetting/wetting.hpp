@@ -42,6 +42,14 @@ struct WettingScratch {
   std::vector<float> clothScale;   // share of its requests a cloth particle grants (Eq. 11)
   std::vector<float> waterScale;   // share of its mass a water particle can give (Eq. 11)
   std::vector<double> waterLost;   // kg each water particle lost to the cloth this pass
+  // absorption's stage 4: for each water particle that lost water, one slot per entry of its list's
+  // cloth part from lostStart[water index]; then the slots of each cloth particle, water ascending
+  std::vector<uint32_t> lostStart;  // per water particle (and one past the end): its first slot
+  std::vector<double> gain;         // kg a slot's cloth particle gains (a share, then the gain)
+  std::vector<uint8_t> absorber;    // the slot's cloth particle takes a share of the water's loss
+  std::vector<uint32_t> gainStart;  // per thread and cloth particle: where its slots start in gainSlot
+  std::vector<uint32_t> gainSlot;   // slots by cloth particle, water ascending
+  std::vector<uint32_t> gainWater;  // the water particle of each of them
   std::vector<uint8_t> isDrip;     // water particles hanging as drips (not absorbed)
   std::vector<uint8_t> keep;       // 0 for water absorbed whole; compacted by finishWetting
   bool anyAbsorbedWhole = false;
