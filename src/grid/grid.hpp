@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 namespace soak {
@@ -62,13 +64,34 @@ struct NeighborGrid {
   }
 };
 
+// an allocator whose resize leaves new elements uninitialised (default-initialised): the lists are
+// written in full after each resize, and value-initialising them was a serial fill of every entry
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  UninitAllocator() = default;
+  template <class U>
+  UninitAllocator(const UninitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 // neighbour lists, kept through the solver iterations of a step: neighbours of i are
 // index[start[i] .. start[i + 1]), excluding i itself, in a fixed order. Those with an index below
 // firstWater (the cloth particles) come first, in [start[i], mid[i]); the others follow in
 // [mid[i], start[i + 1]), so a loop over one kind skips the other.
 struct NeighborLists {
   std::vector<uint32_t> start;
-  std::vector<uint32_t> index;
+  std::vector<uint32_t, UninitAllocator<uint32_t>> index;
   std::vector<uint32_t> mid;
   uint32_t firstWater = 0;              // the index split the lists were built with
   std::vector<float> px, py, pz, ph;   // scratch of the build: candidates' positions and radii in cellEntries order
