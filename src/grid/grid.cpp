@@ -420,11 +420,13 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   };
 
   // room for the lists: last build's total and an eighth (exact on the first build, from a count
-  // pass), so the index array is not reallocated while it is filled
+  // pass), so the index array is not reallocated while it is filled. The room is kept while it holds
+  // the last total and a sixteenth: asking for last + last / 8 each time reallocated the array (fresh
+  // pages, touched serially) whenever the total had grown by one entry
   const size_t last = lists.index.size();
   lists.index.clear();
   if (last > 0) {
-    lists.index.reserve(last + last / 8);
+    if (lists.index.capacity() < last + last / 16) lists.index.reserve(last + last / 8);
   } else {
     size_t total = 0;
 #pragma omp parallel if (parallel) reduction(+ : total)
