@@ -115,6 +115,11 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
   s.lostStart[0] = 0;
   for (int64_t k = 0; k < nw; ++k)
     s.lostStart[k + 1] = s.lostStart[k] + (s.waterLost[nc + k] > 0.0 ? nb.clothEnd(nc + k, cloth) - nb.start[nc + k] : 0u);
+  size_t whole = 0;
+  for (int64_t j = nc; j < n; ++j) whole += s.waterLost[j] > 0.0 && !s.keep[j] ? 1 : 0;
+  s.anyAbsorbedWhole = whole > 0;
+  state.ledger.particlesAbsorbed += whole;
+  if (s.lostStart[nw] == 0) return whole;  // no water lost any: nothing to hand out
   s.gain.resize(s.lostStart[nw]);
   s.absorber.resize(s.lostStart[nw]);
   parallelFor(nw, [&](int64_t k) {
@@ -195,10 +200,6 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       p.mass[i] = mi + dm;
     }
   });
-  size_t whole = 0;
-  for (int64_t j = nc; j < n; ++j) whole += s.waterLost[j] > 0.0 && !s.keep[j] ? 1 : 0;
-  s.anyAbsorbedWhole = whole > 0;
-  state.ledger.particlesAbsorbed += whole;
   return whole;
 }
 
