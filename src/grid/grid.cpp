@@ -461,7 +461,9 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
       std::vector<uint32_t> cl(256), wa(256);
 #pragma omp for schedule(dynamic, 1)
       for (int64_t c = 0; c < chunks; ++c) {
-        std::vector<uint32_t>& out = lists.chunkBuffers[static_cast<size_t>(c)];
+        // the chunk's buffer held here while it grows: the buffers' vector headers share cache lines,
+        // and each insert to a header in the shared array took the line from the other core
+        std::vector<uint32_t> out = std::move(lists.chunkBuffers[static_cast<size_t>(c)]);
         out.clear();
         const size_t lo = r0 + static_cast<size_t>(c) * kChunk, hi = std::min(n, lo + kChunk);
         for (size_t i = lo; i < hi; ++i) {
@@ -472,6 +474,7 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
           out.insert(out.end(), cl.data(), cl.data() + ncl);
           out.insert(out.end(), wa.data(), wa.data() + nwa);
         }
+        lists.chunkBuffers[static_cast<size_t>(c)] = std::move(out);
       }
 #pragma omp single
       {

@@ -315,7 +315,9 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
     seenCloth.assign(static_cast<size_t>(nc), ~0u);
 #pragma omp for schedule(dynamic, 1)
     for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-      std::vector<uint32_t>& out = s.chunkCandidates[static_cast<size_t>(chunk)];
+      // the chunk's list held here while it grows: the chunks' vector headers share cache lines, and
+      // each push_back to a header in the shared array took the line from the other core
+      std::vector<uint32_t> out = std::move(s.chunkCandidates[static_cast<size_t>(chunk)]);
       out.clear();
       const int64_t begin = chunk * kWaterChunk, end = std::min(nw, begin + kWaterChunk);
       for (int64_t w = begin; w < end; ++w) {
@@ -343,6 +345,7 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
         s.nearestCloth[static_cast<size_t>(w)] = nearest;
         s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
       }
+      s.chunkCandidates[static_cast<size_t>(chunk)] = std::move(out);
     }
 #pragma omp single
     {
@@ -494,7 +497,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   // own list, and the lists are summed in water order below, for any thread count
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nThreads)
   for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-    std::vector<CouplingContact>& out = s.chunkContacts[static_cast<size_t>(chunk)];
+    std::vector<CouplingContact> out = std::move(s.chunkContacts[static_cast<size_t>(chunk)]);  // held here: see findCouplingCandidates
     out.clear();
     const int64_t begin = nc + chunk * kWaterChunk, end = std::min(n, begin + kWaterChunk);
     for (int64_t q = begin; q < end; ++q) {
@@ -588,6 +591,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }
+    s.chunkContacts[static_cast<size_t>(chunk)] = std::move(out);
   }
   // cloth corrections summed in water order, averaged per vertex (Jacobi)
   uint64_t contacts = 0;
