@@ -191,9 +191,14 @@ void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense
         if (y < 0 || y >= d.y()) continue;
         const float gy = slabGap(f[1], oy, cs), gz = slabGap(f[2], oz, cs), yz2 = gy * gy + gz * gz;
         if (yz2 >= reach2) continue;
+        // cell x of the row is within reach
+        const auto reaches = [&](int x) {
+          const float gx = slabGap(f[0], x - cell[0], cs);
+          return yz2 + gx * gx < reach2;
+        };
         int x0 = cell[0], x1 = cell[0];
-        while (x0 > 0 && x0 > cell[0] - R && yz2 + slabGap(f[0], x0 - 1 - cell[0], cs) * slabGap(f[0], x0 - 1 - cell[0], cs) < reach2) --x0;
-        while (x1 + 1 < d.x() && x1 < cell[0] + R && yz2 + slabGap(f[0], x1 + 1 - cell[0], cs) * slabGap(f[0], x1 + 1 - cell[0], cs) < reach2) ++x1;
+        while (x0 > 0 && x0 > cell[0] - R && reaches(x0 - 1)) --x0;
+        while (x1 + 1 < d.x() && x1 < cell[0] + R && reaches(x1 + 1)) ++x1;
         const size_t row = static_cast<size_t>(z * d.y() + y) * d.x();
         const uint32_t k0 = lists.denseStart[row + x0], k1 = lists.denseStart[row + x1 + 1];
         if (k0 != k1) ranges.insert(ranges.end(), {k0, k1});

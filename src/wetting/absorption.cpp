@@ -151,7 +151,8 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
   const int threads = threadCount();
   const size_t stride = static_cast<size_t>(nc) + 1;
   s.gainStart.assign(stride * static_cast<size_t>(threads), 0);
-  std::vector<uint32_t> first(stride, 0);
+  std::vector<uint32_t>& first = s.gainFirst;
+  first.resize(stride);
 #pragma omp parallel num_threads(threads) if (s.lostStart[nw] >= 512)
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();

@@ -75,17 +75,21 @@ float addNewDrips(float rho, const Particles& p, size_t gridSize, const Vec3& y,
   return rho;
 }
 
-// placement t (0 .. kDripTries - 1) of a drip of radius hp below cloth particle i, whose vertex normal is
-// n: along gravity first, then off the cloth's surface on either side, at 1/4 .. 6/4 hp. False when
-// the direction does not exist (no gravity, a degenerate normal)
+// where a drip may go below a cloth particle whose vertex normal is n: along gravity g first, then off
+// the cloth's surface on either side (dirs), at 1/4 .. 6/4 h_p along each: placement t is
+// dirs[t / 6] at (t % 6 + 1) / 4 h_p
 constexpr int kDripTries = 30;
-bool dripPlacement(const Vec3& xi, const Vec3& g, const Vec3& n, float hp, int t, Vec3& y) {
-  const Vec3 dirs[5] = {g, (g + n).normalized(), (g - n).normalized(), n, -n};
-  const Vec3& dir = dirs[t / 6];
-  if (!dir.allFinite() || dir.squaredNorm() < 0.5f) return false;
-  y = xi + (0.25f * static_cast<float>(t % 6 + 1) * hp) * dir;
-  return true;
-}
+struct DripDirections {
+  Vec3 dirs[5];
+  explicit DripDirections(const Vec3& g, const Vec3& n) : dirs{g, (g + n).normalized(), (g - n).normalized(), n, -n} {}
+  // placement t from x_i; false when its direction does not exist (no gravity, a degenerate normal)
+  bool placement(const Vec3& xi, float hp, int t, Vec3& y) const {
+    const Vec3& dir = dirs[t / 6];
+    if (!dir.allFinite() || dir.squaredNorm() < 0.5f) return false;
+    y = xi + (0.25f * static_cast<float>(t % 6 + 1) * hp) * dir;
+    return true;
+  }
+};
 
 }  // namespace
 
@@ -299,13 +303,15 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const int64_t nSources = static_cast<int64_t>(sources.size());
   s.dripTry.assign(sources.size(), -1);
   s.dripBase.assign(sources.size(), 0.0f);
+  s.dripNormal.resize(sources.size());
 #pragma omp parallel for schedule(dynamic, 4) if (nSources > 8)
   for (int64_t c = 0; c < nSources; ++c) {
     const int32_t i = sources[static_cast<size_t>(c)];
-    const Vec3 n = vertexNormal(model, p.x, i);
+    s.dripNormal[static_cast<size_t>(c)] = vertexNormal(model, p.x, i);
+    const DripDirections along(g, s.dripNormal[static_cast<size_t>(c)]);
     for (int t = 0; t < kDripTries; ++t) {
       Vec3 y;
-      if (!dripPlacement(p.x[i], g, n, hDrip, t, y)) continue;
+      if (!along.placement(p.x[i], hDrip, t, y)) continue;
       const float rho = dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip);
       if (rho <= rho0) {
         s.dripTry[static_cast<size_t>(c)] = t;
@@ -320,12 +326,12 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     const int32_t i = sources[static_cast<size_t>(c)];
     int t = s.dripTry[static_cast<size_t>(c)];
     if (t < 0) continue;  // crowded: try again at the next wetting pass
-    const Vec3 n = vertexNormal(model, p.x, i);
+    const DripDirections along(g, s.dripNormal[static_cast<size_t>(c)]);
     Vec3 y;
-    dripPlacement(p.x[i], g, n, hDrip, t, y);
+    along.placement(p.x[i], hDrip, t, y);
     bool placed = addNewDrips(s.dripBase[static_cast<size_t>(c)], p, gridSize, y, hDrip) <= rho0;
     while (!placed && ++t < kDripTries)
-      if (dripPlacement(p.x[i], g, n, hDrip, t, y))
+      if (along.placement(p.x[i], hDrip, t, y))
         placed = addNewDrips(dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip), p, gridSize, y, hDrip) <= rho0;
     if (!placed) continue;
     const uint32_t id = state.nextId++;

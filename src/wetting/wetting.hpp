@@ -48,6 +48,7 @@ struct WettingScratch {
   std::vector<double> gain;         // kg a slot's cloth particle gains (a share, then the gain)
   std::vector<uint8_t> absorber;    // the slot's cloth particle takes a share of the water's loss
   std::vector<uint32_t> gainStart;  // per thread and cloth particle: where its slots start in gainSlot
+  std::vector<uint32_t> gainFirst;  // per cloth particle (and one past the end): its first slot in gainSlot
   std::vector<uint32_t> gainSlot;   // slots by cloth particle, water ascending
   std::vector<uint32_t> gainWater;  // the water particle of each of them
   std::vector<uint8_t> isDrip;     // water particles hanging as drips (not absorbed)
@@ -61,6 +62,7 @@ struct WettingScratch {
   std::vector<int32_t> dripSources;  // cloth particles due a new drip this pass, in cloth order
   std::vector<int32_t> dripTry;      // per source: its first placement whose density before this pass's drips is at most rho0 (-1: none)
   std::vector<float> dripBase;       // per source: that density (kg/m^3)
+  std::vector<Vec3> dripNormal;      // per source: its vertex normal (the placements' directions)
   std::vector<Vec3> force;         // N, sticking force per cloth particle (Eq. 20)
   // geometry of the cloth pairs at this pass's positions x (pairGeometry), one value per entry e of
   // the cloth part [start[i], clothEnd(i)) of a cloth particle i's neighbour list, j = index[e], with
