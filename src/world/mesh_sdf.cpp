@@ -7,6 +7,8 @@
 
 #include "core/parallel.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -59,7 +61,8 @@ struct PreparedMesh {
   std::vector<Vec3d> vertexNormal;             // angle-weighted sum of the faces around
 };
 
-std::string edgeText(int a, int b) { return "(" + std::to_string(a) + ", " + std::to_string(b) + ")"; }
+// fmt, not "(" + std::to_string(a) + ...: GCC 12 warned (-Wrestrict, a false positive) on the inlined string concatenation
+std::string edgeText(int a, int b) { return fmt::format("({}, {})", a, b); }
 
 PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
   PreparedMesh m;
