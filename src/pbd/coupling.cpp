@@ -478,6 +478,10 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   s.researchMark.resize(static_cast<size_t>(nThreads));
   s.researchCount.resize(static_cast<size_t>(nThreads), 0u);
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
+  // the rigid pass holds water at dry triangles only (Eq. 22: wet ones let it through): over a sheet
+  // wet everywhere (Fig. 6's saturated cloth) it would visit every candidate to move nothing
+  if (rigidCloth && std::none_of(s.triangleStiffness.begin(), s.triangleStiffness.end(), [](float k) { return k >= 1.0f; }))
+    return 0;
   const int iters = std::max(1, model.solver.couplingIterations);
   // the candidates' planes once per pass, shared by every water particle that tests the triangle
   s.plane.resize(nTri);

@@ -205,6 +205,37 @@ TEST(Step, CouplingSideFollowsTheFaceUnderAParticleOnATightlyCurvedSheet) {
   for (uint32_t c = c0; c < c1; ++c) EXPECT_EQ(s.candidateSide[c], under) << "candidate triangle " << s.candidates[c];
 }
 
+TEST(Step, RigidCouplingPassHoldsWaterAtDryTrianglesOnly) {
+  // a flat sheet and a water particle whose path goes through it: the rigid pass puts it back above
+  // the dry triangles under it, and lets it through where they are wet (Eq. 22), also when every other
+  // triangle is dry or when none is (the pass then does nothing at all)
+  const auto run = [](float under, float elsewhere) {
+    Scene scene = sceneFromJson(R"({
+      "solver": {"gravity": [0, 0, 0], "domain": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
+      "cloth": [{"mesh": {"type": "rectangle", "center": [0, 0, 0], "size": [0.16, 0.16], "resolution": [9, 9],
+                 "axisU": [1, 0, 0], "axisV": [0, 0, 1]}}]
+    })");
+    Particles& p = scene.state.particles;
+    const Vec3 from(0.03f, 0.01f, 0.025f), to(0.03f, -0.02f, 0.025f);
+    p.add(kWaterPhase, 1000, scene.model.water.particleMass, scene.model.water.supportRadius, from, Vec3::Zero());
+    p.xPred.back() = to;
+    CouplingScratch s;
+    findCouplingCandidates(scene.model, p, s);
+    s.triangleStiffness.assign(scene.model.triangles.size(), elsewhere);
+    for (size_t t = 0; t < scene.model.triangles.size(); ++t) {
+      Vec3 c = Vec3::Zero();
+      for (int v : scene.model.triangles[t]) c += p.x[static_cast<size_t>(v)] / 3.0f;
+      if ((c - Vec3(from.x(), 0.0f, from.z())).norm() < 0.03f) s.triangleStiffness[t] = under;
+    }
+    solveCoupling(scene.model, p, s, true);
+    return p.xPred.back().y();
+  };
+  EXPECT_GT(run(1.0f, 1.0f), 0.0f);   // dry everywhere: held above
+  EXPECT_GT(run(1.0f, 0.3f), 0.0f);   // dry under it, wet elsewhere: held
+  EXPECT_FLOAT_EQ(run(0.3f, 1.0f), -0.02f);  // wet under it: through
+  EXPECT_FLOAT_EQ(run(0.3f, 0.3f), -0.02f);  // wet everywhere: through, the pass skipped
+}
+
 TEST(Step, Fig3aNoWaterCrossesTheCloth) {
   // Fig. 3(a) of Shao 2017 at full size for 2 simulated seconds, checked after every step: a particle
   // that passed through the sheet and then left the domain is caught too (825 crossings in the first
