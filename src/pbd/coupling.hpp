@@ -69,8 +69,6 @@ struct CouplingScratch {
   std::vector<Vec3> searchedEnd;             // per water particle: the end of the path its candidates were searched along
   float clothRadius = 0.0f;                  // m, the largest cloth support radius when the candidates were searched
   std::vector<Vec3> startNormal;             // unit normal of each triangle at the start of the substep (0: degenerate)
-  std::vector<Vec3> vertexNormal;            // per cloth particle: its triangles' area-weighted normals, summed
-  std::vector<Vec3> sheetNormal;             // the same summed over its 1-ring: the sheet's side at the particle
   std::vector<uint8_t> triangleActive;       // 1: the triangle is some water particle's candidate this substep
   std::vector<uint32_t> activeTriangles;     // those triangles, ascending: the passes compute their planes only
   std::vector<TrianglePlane> plane;          // each active triangle's plane and centroid at the predicted positions
