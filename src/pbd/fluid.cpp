@@ -131,6 +131,28 @@ bool markMixedRadius(const std::vector<float>& radius, const NeighborLists& nb, 
   return !odd.empty();
 }
 
+// the water particles whose pairs all are with water of water.particleMass m0 and radius h0, as is
+// the particle itself ("plain": most of a pool): their density pass takes m_j = m0 and w_j = 1 / m0
+// as constants instead of gathering them, the same numbers (docs/performance.md, session 11). A cloth
+// neighbour (Psi_b, its own w), a drip or a partly absorbed particle makes its neighbours not plain
+void markPlain(const Particles& p, const NeighborLists& nb, int64_t nc, float m0, float h0, std::vector<uint8_t>& plain) {
+  const int64_t n = static_cast<int64_t>(p.size());
+  const float w0 = m0 > 0.0f ? 1.0f / m0 : 0.0f;  // as Particles::add
+  const auto own = [&](int64_t i) {
+    return i >= nc && p.mass[i] == m0 && p.invMass[i] == w0 && p.radius[i] == h0 && p.phase[i] == kWaterPhase;
+  };
+  plain.resize(static_cast<size_t>(n));
+  uint8_t* const out = plain.data();
+  parallelFor(n, [&](int64_t i) { out[i] = own(i); });
+  // the lists are symmetric: the particles that are not plain themselves unmark their neighbours (the
+  // cloth and the few drips, not every pair of the pool)
+  parallelFor(n, [&](int64_t i) {
+    if (own(i)) return;
+    for (uint32_t k = nb.waterBegin(static_cast<size_t>(i), static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k)
+      __atomic_store_n(out + nb.index[k], uint8_t{0}, __ATOMIC_RELAXED);  // cloth neighbours are not plain anyway
+  });
+}
+
 // what the pair loops of one solver pass read: the positions, radii, masses (Psi for cloth), inverse
 // masses and lambdas of every particle, and the pass's constants
 struct PairInputs {
@@ -154,6 +176,7 @@ struct PairInputs {
   float* cacheGz = nullptr;
   float* cacheR2 = nullptr;
   uint32_t cacheBase = 0;
+  float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markPlain)
 };
 
 #if defined(__AVX512F__)
@@ -259,7 +282,7 @@ inline ScalarPair scalarPair(const PairInputs& in, uint32_t k, float xi, float y
 
 // lambda pass of water particle i over its neighbours [k0, k1): rho_i without itself, grad_i C_i
 // without the walls (times rho0) and sum_j w_j |grad_j C_i|^2
-template <bool U>
+template <bool U, bool Plain = false>
 inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1, float& rho, Vec3& grad,
                         float& sumOthers) {
   const float* X = in.X;
@@ -276,7 +299,9 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const __mmask16 m = q.m;
       const __m512i j = q.j;
       const __m512 rx = q.rx, ry = q.ry, rz = q.rz, r2 = q.r2;
-      const __m512 mj = gatherOf(q, in.M), wj = gatherOf(q, in.W);
+      // plain (markPlain): every neighbour's m_j and w_j are the constants, 0 past the list's end as gathered
+      const __m512 mj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainM)) : gatherOf(q, in.M);
+      const __m512 wj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainW)) : gatherOf(q, in.W);
       const Kernel kern = kernelOf<U>(in, m, j, hi);
       const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
       sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
@@ -503,6 +528,10 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const uint8_t* const mixed = s.mixedRadius.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
                 nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
+  markPlain(p, nb, nc, wp.particleMass, hU, s.plain);
+  const uint8_t* const plain = s.plain.data();
+  in.plainM = wp.particleMass;
+  in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
   // the pair cache: 12 bytes a pair of the water's lists (16 with artificial pressure, whose s_corr
   // needs |r|^2), when that fits s.pairCacheLimit (not the 1M-particle block: its memory target). It
   // spares the correction pass four gathers, a square root and a division a pair
@@ -524,7 +553,9 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         const float hi = H[i], mi = p.mass[i];
         float rho = 0.0f, sumOthers = 0.0f;  // sumOthers: sum over neighbours of w_k |grad_k C|^2
         Vec3 gradI;
-        if (U || !mixed[i])
+        if (plain[i])  // radius h0 too: the constant-radius loop
+          densitySums<true, true>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
+        else if (U || !mixed[i])
           densitySums<true>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
         else
           densitySums<false>(in, i, nb.start[i], nb.start[i + 1], rho, gradI, sumOthers);
