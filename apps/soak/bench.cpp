@@ -190,6 +190,14 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   stage("wetting", &StageTimes::wetting);
   stage("garment", &StageTimes::garment);
   stage("total", &StageTimes::total);
+  json parts = json::object(), partsMean = json::object();  // StagePart, as the stages
+  for (int k = 0; k < kStagePartCount; ++k) {
+    std::vector<double> v;
+    double sum = 0.0;
+    for (const StepStats& st : timed) v.push_back(st.ms.parts[k]), sum += st.ms.parts[k];
+    parts[kStagePartNames[k]] = median(v);
+    partsMean[kStagePartNames[k]] = sum / static_cast<double>(v.size());
+  }
   uint64_t contacts = 0;
   for (const StepStats& st : timed) contacts += st.couplingContacts;
   const double meanTotal = msMean["total"].get<double>();
@@ -212,6 +220,8 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
             {"msPerStepMedian", ms},
             {"msPerStepMean", meanTotal},
             {"msPerStepMeanStages", msMean},
+            {"msPerStepMedianParts", parts},
+            {"msPerStepMeanParts", partsMean},
             {"nsPerParticleStep", particles > 0 ? medianTotal * 1e6 / static_cast<double>(particles) : 0.0},
             {"couplingContactsPerStep", timed.empty() ? 0.0 : static_cast<double>(contacts) / timed.size()},
             {"peakRssBytes", peak},
@@ -305,6 +315,29 @@ void printTable(const std::vector<json>& results) {
                        : "median over the timed steps");
 }
 
+// --stages: the parts of the stages (StagePart), a column each, grouped by stage
+void printParts(const std::vector<json>& results) {
+  std::printf("\n%-18s", "parts (ms)");
+  for (int k = 0; k < kStagePartCount; ++k) {
+    const std::string name = kStagePartNames[k];
+    std::printf(" %*s", std::max<int>(8, static_cast<int>(name.size() - name.find('.') - 1)), name.substr(name.find('.') + 1).c_str());
+  }
+  std::printf("\n");
+  for (const json& r : results) {
+    if (r.contains("error") || !r.contains("msPerStepMedianParts")) continue;
+    const json& parts = r[r.value("wholeRun", false) ? "msPerStepMeanParts" : "msPerStepMedianParts"];
+    std::printf("%-18s", r["name"].get<std::string>().c_str());
+    for (int k = 0; k < kStagePartCount; ++k) {
+      const std::string name = kStagePartNames[k];
+      std::printf(" %*.2f", std::max<int>(8, static_cast<int>(name.size() - name.find('.') - 1)), parts[name].get<double>());
+    }
+    std::printf("\n");
+  }
+  std::printf("(neighbors: grid, lists; cloth: solve (with the tethers), selfCollision; coupling: search (with Eq. 22's "
+              "stiffness), passes (the rigid one too); velocities: xsph; wetting: its seven stages, once a step; "
+              "each within its stage's time above)\n");
+}
+
 }  // namespace
 
 int benchCommand(const BenchOptions& o) {
@@ -330,6 +363,7 @@ int benchCommand(const BenchOptions& o) {
     results.push_back(std::move(r));
   }
   if (!o.quiet) printTable(results);
+  if (!o.quiet && o.stages) printParts(results);
   if (!o.json.empty()) {
     const json doc = {{"soak", kVersion}, {"results", results}};
     writeTextFile(o.json, doc.dump(2) + "\n");

@@ -46,6 +46,7 @@ struct BenchOptions {
   std::vector<std::string> overrides;  // --set, applied to every scene
   bool inProcess = false;              // run the scenes in this process (no re-exec per scene)
   bool wholeRun = false;               // time every step of the scene's own duration, no warm-up
+  bool stages = false;                 // also print the stages' parts (StagePart) per scene
   bool quiet = false;
 };
 

@@ -74,6 +74,9 @@ int realMain(int argc, char** argv) {
       ->take_all();
   benchCmd->add_flag("--in-process", bench.inProcess,
                      "run every scene in this process (peak memory is then shared between scenes)");
+  benchCmd->add_flag("--stages", bench.stages,
+                     "also print the parts of the stages per scene: the wetting stages one by one, the neighbour "
+                     "grid and lists, the cloth solve and self-collision, the coupling search and passes, XSPH");
   benchCmd->add_flag("-q,--quiet", bench.quiet, "print no table (with --json)");
 
   RenderCliOptions render;

@@ -4,13 +4,30 @@
 
 namespace soak {
 
+// parts of the stages below (ms), named "stage.part": the wetting stages one by one (Table 2 of Shao
+// 2017 gives the wetting's time apart from the total), and the parts of the neighbour search, cloth,
+// coupling and velocity stages (`soak bench --stages`; docs/performance.md on finding serial work)
+enum class StagePart : int {
+  neighborsGrid, neighborsLists, clothSolve, clothSelfCollision, couplingSearch, couplingPasses, velocitiesXsph,
+  wettingPorosity, wettingAbsorption, wettingDiffusion, wettingEmission, wettingAttraction, wettingSticking,
+  wettingFinish, count
+};
+inline constexpr int kStagePartCount = static_cast<int>(StagePart::count);
+inline constexpr const char* kStagePartNames[kStagePartCount] = {
+    "neighbors.grid",     "neighbors.lists",    "cloth.solve",        "cloth.selfCollision", "coupling.search",
+    "coupling.passes",    "velocities.xsph",    "wetting.porosity",   "wetting.absorption",  "wetting.diffusion",
+    "wetting.emission",   "wetting.attraction", "wetting.sticking",   "wetting.finish"};
+
 struct StageTimes {         // ms of wall time per stage
   double emit = 0, predict = 0, neighbors = 0, water = 0, cloth = 0, coupling = 0, colliders = 0,
          velocities = 0, wetting = 0, garment = 0, total = 0;
+  double parts[kStagePartCount] = {};  // each within its stage's time (StagePart)
+  double& part(StagePart k) { return parts[static_cast<int>(k)]; }
   StageTimes& operator+=(const StageTimes& o) {
     emit += o.emit; predict += o.predict; neighbors += o.neighbors; water += o.water; cloth += o.cloth;
     coupling += o.coupling; colliders += o.colliders; velocities += o.velocities; wetting += o.wetting;
     garment += o.garment; total += o.total;
+    for (int k = 0; k < kStagePartCount; ++k) parts[k] += o.parts[k];
     return *this;
   }
 };

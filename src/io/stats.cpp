@@ -46,6 +46,12 @@ static nlohmann::ordered_json stageJson(const StageTimes& t) {
           {"garment", t.garment},   {"total", t.total}};
 }
 
+nlohmann::ordered_json stagePartsJson(const StageTimes& t) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (int k = 0; k < kStagePartCount; ++k) j[kStagePartNames[k]] = t.parts[k];
+  return j;
+}
+
 nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, int frame, const FrameStats& fs) {
   const Particles& p = state.particles;
   uint64_t water = 0;
@@ -90,6 +96,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
     j["meanDensityRatio"] = nullptr;
   j["maxSpeed"] = fs.steps > 0 ? fs.maxSpeed : stateMaxSpeed(state);
   j["ms"] = stageJson(fs.ms);
+  j["msParts"] = stagePartsJson(fs.ms);
   j["msPerStep"] = fs.steps > 0 ? fs.ms.total / fs.steps : 0.0;
   return j;
 }

@@ -37,6 +37,9 @@ struct WaterMass {
 };
 WaterMass waterMass(const State& state);
 
+// the parts of the stages (StagePart) as {"stage.part": ms}, in StagePart's order
+nlohmann::ordered_json stagePartsJson(const StageTimes& t);
+
 // the largest particle speed in the state (m/s), used for frame 0 where no step ran
 float stateMaxSpeed(const State& state);
 

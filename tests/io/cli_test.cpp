@@ -232,10 +232,15 @@ TEST(CliBench, TimesEachSceneInItsOwnProcess) {
   const std::string a = cli.writeScene("tiny_a.json", kTinyScene);
   const std::string b = cli.writeScene("tiny_b.json", kTinyScene);
   const fs::path json = cli.dir() / "bench.json";
-  const Result r = cli.run("bench --scene '" + a + "' --scene '" + b + "' --steps 2 --warmup 1 --threads 1 --json '" +
+  const Result r = cli.run("bench --scene '" + a + "' --scene '" + b + "' --steps 2 --warmup 1 --threads 1 --stages --json '" +
                            json.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("tiny_a"), std::string::npos) << r.out;
+  // --stages: a second table of the stages' parts, a line a scene
+  const size_t parts = r.out.find("parts (ms)");
+  ASSERT_NE(parts, std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("selfCollision", parts), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tiny_b", parts), std::string::npos) << r.out;
   const nlohmann::json doc = nlohmann::json::parse(readTextFile(json.string()));
   ASSERT_EQ(doc["results"].size(), 2u);
   for (const nlohmann::json& res : doc["results"]) {
@@ -245,6 +250,9 @@ TEST(CliBench, TimesEachSceneInItsOwnProcess) {
     EXPECT_EQ(res["steps"], 2);
     EXPECT_EQ(res["threads"], 1);
     EXPECT_GT(res["msPerStepMedian"]["total"].get<double>(), 0.0);
+    EXPECT_GT(res["msPerStepMedianParts"]["neighbors.lists"].get<double>(), 0.0);
+    EXPECT_LE(res["msPerStepMeanParts"]["neighbors.lists"].get<double>(),
+              res["msPerStepMeanStages"]["neighbors"].get<double>() * (1.0 + 1e-9));
     EXPECT_GT(res["peakRssBytes"].get<double>(), 1e6);
     EXPECT_NEAR(res["bytesPerParticle"].get<double>(), res["peakRssBytes"].get<double>() / 164.0, 1e-6);
   }

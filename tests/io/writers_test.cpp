@@ -313,6 +313,7 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   StepStats a, b;
   a.substeps = 2;
   a.ms.neighbors = 1.0;
+  a.ms.part(StagePart::neighborsLists) = 0.75;
   a.ms.total = 4.0;
   a.couplingContacts = 10;
   a.meanDensityRatio = 0.9f;
@@ -320,6 +321,8 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   a.removedParticles = 1;
   b.substeps = 2;
   b.ms.neighbors = 0.5;
+  b.ms.part(StagePart::neighborsLists) = 0.25;
+  b.ms.part(StagePart::wettingEmission) = 0.5;
   b.ms.total = 2.0;
   b.couplingContacts = 5;
   b.meanDensityRatio = 1.1f;
@@ -345,6 +348,11 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   EXPECT_DOUBLE_EQ(j["msPerStep"].get<double>(), 3.0);
   for (const char* stage : {"emit", "predict", "neighbors", "water", "cloth", "coupling", "colliders", "velocities"})
     EXPECT_TRUE(j["ms"].contains(stage)) << stage;
+  // the stages' parts, summed over the frame's steps, every one named
+  ASSERT_EQ(j["msParts"].size(), static_cast<size_t>(kStagePartCount));
+  EXPECT_DOUBLE_EQ(j["msParts"]["neighbors.lists"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(j["msParts"]["wetting.emission"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j["msParts"]["wetting.absorption"].get<double>(), 0.0);
   // free = sum of water masses (0.0082 + 0.0072 + ... + 0.0042) in float
   double free = 0.0;
   for (int k = 0; k < 5; ++k) free += 0.0082f - 0.001f * k;

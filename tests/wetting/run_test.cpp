@@ -50,6 +50,23 @@ TEST(WettingRun, JetRunConservesWater) {
   EXPECT_GT(s.state.ledger.particlesAbsorbed, 0u);
   EXPECT_GT(st.ms.wetting, 0.0);
   EXPECT_TRUE(checkState(s.model, s.state).empty()) << checkState(s.model, s.state);
+  // the wetting stages timed one by one (Table 2 gives the wetting apart): each part within its stage
+  // (up to the rounding of sums taken in another order)
+  const auto within = [](double parts, double stage) { return parts <= stage * (1.0 + 1e-9) + 1e-12; };
+  double wetParts = 0.0;
+  for (StagePart k : {StagePart::wettingPorosity, StagePart::wettingAbsorption, StagePart::wettingDiffusion,
+                      StagePart::wettingEmission, StagePart::wettingAttraction, StagePart::wettingSticking,
+                      StagePart::wettingFinish})
+    wetParts += st.ms.part(k);
+  EXPECT_GT(st.ms.part(StagePart::wettingAbsorption), 0.0);
+  EXPECT_GT(st.ms.part(StagePart::wettingDiffusion), 0.0);
+  EXPECT_GT(wetParts, 0.5 * st.ms.wetting);
+  EXPECT_TRUE(within(wetParts, st.ms.wetting));
+  EXPECT_GT(st.ms.part(StagePart::neighborsLists), 0.0);
+  EXPECT_TRUE(within(st.ms.part(StagePart::neighborsGrid) + st.ms.part(StagePart::neighborsLists), st.ms.neighbors));
+  EXPECT_TRUE(within(st.ms.part(StagePart::clothSolve) + st.ms.part(StagePart::clothSelfCollision), st.ms.cloth));
+  EXPECT_TRUE(within(st.ms.part(StagePart::couplingSearch) + st.ms.part(StagePart::couplingPasses), st.ms.coupling));
+  EXPECT_TRUE(within(st.ms.part(StagePart::velocitiesXsph), st.ms.velocities));
 }
 
 TEST(WettingRun, SameStateWithOneAndTwoThreads) {
