@@ -315,22 +315,19 @@ void printTable(const std::vector<json>& results) {
                        : "median over the timed steps");
 }
 
-// --stages: the parts of the stages (StagePart), a column each, grouped by stage
+// --stages: the parts of the stages (StagePart), a column each headed by the part's name in its stage
 void printParts(const std::vector<json>& results) {
+  std::vector<std::string> heads;
+  for (const char* name : kStagePartNames) heads.push_back(std::string(name).substr(std::string(name).find('.') + 1));
+  const auto width = [&](int k) { return std::max<int>(8, static_cast<int>(heads[static_cast<size_t>(k)].size())); };
   std::printf("\n%-18s", "parts (ms)");
-  for (int k = 0; k < kStagePartCount; ++k) {
-    const std::string name = kStagePartNames[k];
-    std::printf(" %*s", std::max<int>(8, static_cast<int>(name.size() - name.find('.') - 1)), name.substr(name.find('.') + 1).c_str());
-  }
+  for (int k = 0; k < kStagePartCount; ++k) std::printf(" %*s", width(k), heads[static_cast<size_t>(k)].c_str());
   std::printf("\n");
   for (const json& r : results) {
     if (r.contains("error") || !r.contains("msPerStepMedianParts")) continue;
     const json& parts = r[r.value("wholeRun", false) ? "msPerStepMeanParts" : "msPerStepMedianParts"];
     std::printf("%-18s", r["name"].get<std::string>().c_str());
-    for (int k = 0; k < kStagePartCount; ++k) {
-      const std::string name = kStagePartNames[k];
-      std::printf(" %*.2f", std::max<int>(8, static_cast<int>(name.size() - name.find('.') - 1)), parts[name].get<double>());
-    }
+    for (int k = 0; k < kStagePartCount; ++k) std::printf(" %*.2f", width(k), parts[kStagePartNames[k]].get<double>());
     std::printf("\n");
   }
   std::printf("(neighbors: grid, lists; cloth: solve (with the tethers), selfCollision; coupling: search (with Eq. 22's "
