@@ -254,7 +254,8 @@ int runCommand(const RunOptions& o) {
         const std::string name = kStagePartNames[k];
         if (name.rfind("wetting.", 0) == 0) parts += fmt::format("{}{} {:.2f}", parts.empty() ? "" : ", ", name.substr(8), runMs.parts[k] / steps);
       }
-      std::printf("soak: wetting %.2f of %.2f ms a step (%s)\n", runMs.wetting / steps, runMs.total / steps, parts.c_str());
+      std::printf("soak: solver %.2f ms a step (frames not written), of which wetting %.2f (%s)\n", runMs.total / steps,
+                  runMs.wetting / steps, parts.c_str());
     }
     std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
                 "removed at bounds %.6g kg (%llu particles) + taken in by garments %.6g kg; unaccounted %.3g kg\n",
