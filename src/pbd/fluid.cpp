@@ -112,44 +112,43 @@ bool commonRadius(const std::vector<float>& radius, float& h) {
   return lo == radius.end() || *lo == *hi;
 }
 
-// when not every particle has the support radius h0 (partial absorption shrinks water, Eq. 11):
-// marks the particles with a pair whose radius is not h0, i.e. those of another radius and their
-// neighbours (the lists are symmetric: r < (h_i + h_j) / 2). Only these need the per-pair radius;
-// the others take the constant h0 (the same values: (h0 + h0) / 2 = h0). Returns whether any is marked
-bool markMixedRadius(const std::vector<float>& radius, const NeighborLists& nb, float h0, std::vector<uint8_t>& mixed) {
-  const size_t n = radius.size();
-  mixed.assign(n, 0);
-  std::vector<uint32_t> odd;
-  for (size_t i = 0; i < n; ++i)
-    if (radius[i] != h0) odd.push_back(static_cast<uint32_t>(i));
-  uint8_t* const m = mixed.data();
-  parallelFor(static_cast<int64_t>(odd.size()), [&](int64_t k) {
-    const uint32_t o = odd[static_cast<size_t>(k)];
-    __atomic_store_n(m + o, uint8_t{1}, __ATOMIC_RELAXED);  // two odd particles may mark a common neighbour
-    for (uint32_t e = nb.start[o]; e < nb.start[o + 1]; ++e) __atomic_store_n(m + nb.index[e], uint8_t{1}, __ATOMIC_RELAXED);
-  });
-  return !odd.empty();
-}
-
-// the water particles whose pairs all are with water of water.particleMass m0 and radius h0, as is
-// the particle itself ("plain": most of a pool): their density pass takes m_j = m0 and w_j = 1 / m0
-// as constants instead of gathering them, the same numbers (docs/performance.md, session 11). A cloth
-// neighbour (Psi_b, its own w), a drip or a partly absorbed particle makes its neighbours not plain
-void markPlain(const Particles& p, const NeighborLists& nb, int64_t nc, float m0, float h0, std::vector<uint8_t>& plain) {
+// Two flags per particle, set by the particles that differ from a pool's and their neighbours (the
+// lists are symmetric: r < (h_i + h_j) / 2), not by a pass over every pair:
+// - mixed (null: every radius is h0): a pair of the particle's list has a radius other than h0 (partial
+//   absorption shrinks water, Eq. 11). Only these need the per-pair radius; the others take the
+//   constant h0 (the same values: (h0 + h0) / 2 = h0).
+// - plain (null: not wanted): a water particle of water.particleMass m0 and radius h0 whose neighbours
+//   all are ("plain": most of a pool). Its density pass takes m_j = m0 and w_j = 1 / m0 as constants
+//   instead of gathering them, the same numbers (docs/performance.md, session 11). A cloth neighbour
+//   (Psi_b, its own w), a drip or a partly absorbed particle makes its neighbours not plain.
+void markNeighbourhoods(const Particles& p, const NeighborLists& nb, int64_t nc, float m0, float h0,
+                        std::vector<uint8_t>* mixed, std::vector<uint8_t>* plain) {
   const int64_t n = static_cast<int64_t>(p.size());
   const float w0 = m0 > 0.0f ? 1.0f / m0 : 0.0f;  // as Particles::add
+  const auto odd = [&](int64_t i) { return p.radius[i] != h0; };
   const auto own = [&](int64_t i) {
-    return i >= nc && p.mass[i] == m0 && p.invMass[i] == w0 && p.radius[i] == h0 && p.phase[i] == kWaterPhase;
+    return i >= nc && p.mass[i] == m0 && p.invMass[i] == w0 && !odd(i) && p.phase[i] == kWaterPhase;
   };
-  plain.resize(static_cast<size_t>(n));
-  uint8_t* const out = plain.data();
-  parallelFor(n, [&](int64_t i) { out[i] = own(i); });
-  // the lists are symmetric: the particles that are not plain themselves unmark their neighbours (the
-  // cloth and the few drips, not every pair of the pool)
+  if (mixed) mixed->resize(static_cast<size_t>(n));
+  if (plain) plain->resize(static_cast<size_t>(n));
+  uint8_t* const mx = mixed ? mixed->data() : nullptr;
+  uint8_t* const pl = plain ? plain->data() : nullptr;
   parallelFor(n, [&](int64_t i) {
-    if (own(i)) return;
-    for (uint32_t k = nb.waterBegin(static_cast<size_t>(i), static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k)
-      __atomic_store_n(out + nb.index[k], uint8_t{0}, __ATOMIC_RELAXED);  // cloth neighbours are not plain anyway
+    if (mx) mx[i] = odd(i);
+    if (pl) pl[i] = own(i);
+  });
+  // relaxed stores: two particles may mark a common neighbour
+  parallelFor(n, [&](int64_t i) {
+    const bool marksMixed = mx && odd(i);
+    if (!marksMixed && (!pl || own(i))) return;
+    // another radius marks every neighbour mixed; a particle not plain unmarks its water neighbours
+    // (cloth ones are not plain anyway): the cloth and the few drips, not every pair of the pool
+    const uint32_t k0 = marksMixed ? nb.start[i] : nb.waterBegin(static_cast<size_t>(i), static_cast<uint32_t>(nc));
+    for (uint32_t k = k0; k < nb.start[i + 1]; ++k) {
+      const uint32_t j = nb.index[k];
+      if (marksMixed) __atomic_store_n(mx + j, uint8_t{1}, __ATOMIC_RELAXED);
+      if (pl && j >= static_cast<uint32_t>(nc)) __atomic_store_n(pl + j, uint8_t{0}, __ATOMIC_RELAXED);
+    }
   });
 }
 
@@ -176,7 +175,7 @@ struct PairInputs {
   float* cacheGz = nullptr;
   float* cacheR2 = nullptr;
   uint32_t cacheBase = 0;
-  float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markPlain)
+  float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markNeighbourhoods)
 };
 
 #if defined(__AVX512F__)
@@ -299,7 +298,7 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const __mmask16 m = q.m;
       const __m512i j = q.j;
       const __m512 rx = q.rx, ry = q.ry, rz = q.rz, r2 = q.r2;
-      // plain (markPlain): every neighbour's m_j and w_j are the constants, 0 past the list's end as gathered
+      // plain (markNeighbourhoods): every neighbour's m_j and w_j are the constants, 0 past the list's end as gathered
       const __m512 mj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainM)) : gatherOf(q, in.M);
       const __m512 wj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainW)) : gatherOf(q, in.W);
       const Kernel kern = kernelOf<U>(in, m, j, hi);
@@ -524,12 +523,12 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
   // mixed radii: the particles whose pairs all have h0 still take the constant-radius loops
-  if (!uniform) hU = wp.supportRadius, markMixedRadius(p.radius, nb, hU, s.mixedRadius);
+  if (!uniform) hU = wp.supportRadius;
+  markNeighbourhoods(p, nb, nc, wp.particleMass, hU, uniform ? nullptr : &s.mixedRadius, &s.plain);
   const uint8_t* const mixed = s.mixedRadius.data();
+  const uint8_t* const plain = s.plain.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
                 nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
-  markPlain(p, nb, nc, wp.particleMass, hU, s.plain);
-  const uint8_t* const plain = s.plain.data();
   in.plainM = wp.particleMass;
   in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
   // the pair cache: 12 bytes a pair of the water's lists (16 with artificial pressure, whose s_corr
@@ -624,7 +623,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
   // as in solveFluid: only the particles with a pair of another radius take the per-pair radius
-  if (!uniform) hU = wp.supportRadius, markMixedRadius(p.radius, nb, hU, s.mixedRadius);
+  if (!uniform) hU = wp.supportRadius, markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
   const uint8_t* const mixed = s.mixedRadius.data();
   const float invU = 1.0f / hU;
   // one water particle's XSPH velocity (and vorticity)
