@@ -51,17 +51,21 @@ Vec3 vertexNormal(const Model& model, const std::vector<Vec3>& x, int64_t i) {
 // may not reach. Stops once the sum passes limit and returns that partial sum: every term is >= 0
 // and adding one never lowers a float sum, so the whole sum would be above limit too (a drip source
 // under water tried its 30 places against every particle around each: 3.6 of Fig. 9(b)'s 7 ms)
+// W(y - x_j) of a drip of radius hp at y and particle j, over the pair's mean radius; 0 outside it
+float dripKernel(const Particles& p, const Vec3& y, float hp, size_t j) {
+  const float hij = pairRadius(hp, p.radius[j]);
+  const float r2 = (y - p.x[j]).squaredNorm();
+  return r2 < hij * hij ? poly6(r2, hij) : 0.0f;
+}
+
 float dripDensityBefore(const Model& model, const Particles& p, const NeighborGrid& grid, const std::vector<uint32_t>& big,
                         const WettingScratch& s, const Vec3& y, float m, float hp, float limit) {
   const int64_t nc = model.numCloth;
   const float rho0 = model.water.restDensity;
   float rho = m * poly6(0.0f, hp);
   const auto add = [&](size_t j) {
-    const float hij = pairRadius(hp, p.radius[j]);
-    const float r2 = (y - p.x[j]).squaredNorm();
-    if (r2 >= hij * hij) return;
-    const float mj = static_cast<int64_t>(j) < nc ? rho0 * s.volume[j] : p.mass[j];
-    rho += mj * poly6(r2, hij);
+    const float w = dripKernel(p, y, hp, j);
+    if (w > 0.0f) rho += (static_cast<int64_t>(j) < nc ? rho0 * s.volume[j] : p.mass[j]) * w;
   };
   uint32_t ranges[27][2];  // forEachCandidate's order
   const int nr = grid.candidateRanges(grid.cellOf(y), ranges);
@@ -82,9 +86,8 @@ float dripDensityBefore(const Model& model, const Particles& p, const NeighborGr
 // rho (dripDensityBefore at y) plus the drips made in this stage, in index order: the whole density
 float addNewDrips(float rho, const Particles& p, size_t gridSize, const Vec3& y, float hp) {
   for (size_t j = gridSize; j < p.size(); ++j) {
-    const float hij = pairRadius(hp, p.radius[j]);
-    const float r2 = (y - p.x[j]).squaredNorm();
-    if (r2 < hij * hij) rho += p.mass[j] * poly6(r2, hij);
+    const float w = dripKernel(p, y, hp, j);
+    if (w > 0.0f) rho += p.mass[j] * w;
   }
   return rho;
 }
