@@ -171,13 +171,17 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   size_t water = 0;
   for (int32_t ph : state.particles.phase) water += isWater(ph) ? 1 : 0;
   const size_t particles = state.particles.size();
-  json ms = json::object(), msMean = json::object();
-  const auto stage = [&](const char* name, double StageTimes::*field) {
+  // the median and mean over the timed steps of one time, under name in med and mean
+  const auto summarize = [&](json& med, json& mean, const char* name, auto&& time) {
     std::vector<double> v;
     double sum = 0.0;
-    for (const StepStats& st : timed) v.push_back(st.ms.*field), sum += st.ms.*field;
-    ms[name] = median(v);
-    msMean[name] = sum / static_cast<double>(v.size());
+    for (const StepStats& st : timed) v.push_back(time(st.ms)), sum += v.back();
+    med[name] = median(v);
+    mean[name] = sum / static_cast<double>(v.size());
+  };
+  json ms = json::object(), msMean = json::object();
+  const auto stage = [&](const char* name, double StageTimes::*field) {
+    summarize(ms, msMean, name, [&](const StageTimes& t) { return t.*field; });
   };
   stage("emit", &StageTimes::emit);
   stage("predict", &StageTimes::predict);
@@ -191,13 +195,8 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   stage("garment", &StageTimes::garment);
   stage("total", &StageTimes::total);
   json parts = json::object(), partsMean = json::object();  // StagePart, as the stages
-  for (int k = 0; k < kStagePartCount; ++k) {
-    std::vector<double> v;
-    double sum = 0.0;
-    for (const StepStats& st : timed) v.push_back(st.ms.parts[k]), sum += st.ms.parts[k];
-    parts[kStagePartNames[k]] = median(v);
-    partsMean[kStagePartNames[k]] = sum / static_cast<double>(v.size());
-  }
+  for (int k = 0; k < kStagePartCount; ++k)
+    summarize(parts, partsMean, kStagePartNames[k], [&](const StageTimes& t) { return t.parts[k]; });
   uint64_t contacts = 0;
   for (const StepStats& st : timed) contacts += st.couplingContacts;
   const double meanTotal = msMean["total"].get<double>();
