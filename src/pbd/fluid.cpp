@@ -163,6 +163,7 @@ struct PairInputs {
   const float* mass;       // the particle's own mass
   const int32_t* phase;
   const uint32_t* index;   // neighbour lists
+  size_t indexSize;        // their entries (the lanes of the last one stop there)
   float hU, invU;          // the common radius and its reciprocal (uniform case)
   float invRho0;
   float sCorrK, oneMinusDq2;
@@ -179,10 +180,10 @@ struct PairInputs {
 };
 
 #if defined(__AVX512F__)
-// With AVX-512, the pair sums below take 16 neighbours at a time: j's data are gathered, every lane
-// does the scalar loop's arithmetic for its pair (same operations, same order, no FMA), and the sums
-// are kept per lane and added across lanes at the end. Lanes past the list's end gather nothing (mass
-// 0, masked kernels): they add +0. Lists shorter than kSimdMinPairs (spray) take the scalar loop,
+// With AVX-512, the pair sums below take 16 neighbours at a time: j's data are gathered (positions
+// loaded and transposed), every lane does the scalar loop's arithmetic for its pair (same operations,
+// same order, no FMA), and the sums are kept per lane and added across lanes at the end. Lanes past
+// the list's end have mass 0 and masked kernels: they add 0. Lists shorter than kSimdMinPairs (spray) take the scalar loop,
 // which is then faster. The order of the sums depends on the list's length, never on the thread
 // count; results differ from a build without AVX-512 in the last bits. Hand-written: GCC 12
 // vectorised these loops with scalar loads in place of gathers, slower than scalar (docs/performance.md).
@@ -196,21 +197,53 @@ inline __mmask16 lanes(uint32_t k, uint32_t end) {
   return end - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (end - k)) - 1u);
 }
 // the lanes' pairs of particle i: j = index[k .. min(k + 16, end)) (mask m) and r = x_i - x_j,
-// r2 = |r|^2 as the scalar loop rounds it; lanes past end gather 0
+// r2 = |r|^2 as the scalar loop rounds it; past end, j = 0 and r of whatever neighbourPositions read
 struct Pairs {
   __mmask16 m;
   __m512i j;
   __m512 rx, ry, rz, r2;
 };
+// x, y, z of the 16 particles idx[0 .. 16) from 3-float records: one 128-bit load a particle (its
+// fourth float masked off, so the last record reads nothing past the array) and a 4 x 4 transpose in
+// each 128-bit quarter. On AMD Zen 4 three gathers cost about 1.5x as much (docs/performance.md,
+// session 12); the values are the same
+inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& y, __m512& z) {
+  const auto at = [&](int l) { return _mm_maskz_loadu_ps(__mmask8(0x7), X + 3 * static_cast<size_t>(idx[l])); };
+  __m512 a = _mm512_castps128_ps512(at(0)), b = _mm512_castps128_ps512(at(1));
+  __m512 c = _mm512_castps128_ps512(at(2)), d = _mm512_castps128_ps512(at(3));
+  a = _mm512_insertf32x4(a, at(4), 1), b = _mm512_insertf32x4(b, at(5), 1);
+  c = _mm512_insertf32x4(c, at(6), 1), d = _mm512_insertf32x4(d, at(7), 1);
+  a = _mm512_insertf32x4(a, at(8), 2), b = _mm512_insertf32x4(b, at(9), 2);
+  c = _mm512_insertf32x4(c, at(10), 2), d = _mm512_insertf32x4(d, at(11), 2);
+  a = _mm512_insertf32x4(a, at(12), 3), b = _mm512_insertf32x4(b, at(13), 3);
+  c = _mm512_insertf32x4(c, at(14), 3), d = _mm512_insertf32x4(d, at(15), 3);
+  // per quarter: t0 = x0 x1 y0 y1, t1 = z0 z1 0 0, t2 = x2 x3 y2 y3, t3 = z2 z3 0 0
+  // (the maskz forms with every lane: see sum below)
+  constexpr __mmask16 all = 0xFFFF;
+  const __m512 t0 = _mm512_maskz_unpacklo_ps(all, a, b), t1 = _mm512_maskz_unpackhi_ps(all, a, b);
+  const __m512 t2 = _mm512_maskz_unpacklo_ps(all, c, d), t3 = _mm512_maskz_unpackhi_ps(all, c, d);
+  x = _mm512_maskz_shuffle_ps(all, t0, t2, 0x44);
+  y = _mm512_maskz_shuffle_ps(all, t0, t2, 0xEE);
+  z = _mm512_maskz_shuffle_ps(all, t1, t3, 0x44);
+}
+// positionsOf the lanes' neighbours index[k ..), lanes m: past the list's end the lanes read the next
+// lists' neighbours (valid particles, masked by the callers); at the end of the index array they read
+// particle 0. A copy of the lanes would be slower: its scalar loads wait for the vector store
+inline void neighbourPositions(const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x, __m512& y, __m512& z) {
+  if (k + 16 <= in.indexSize) return positionsOf(in.X, in.index + k, x, y, z);
+  alignas(64) uint32_t copy[16];
+  _mm512_store_si512(copy, _mm512_maskz_mov_epi32(m, j));
+  positionsOf(in.X, copy, x, y, z);
+}
 inline Pairs pairsAt(const PairInputs& in, uint32_t k, uint32_t end, __m512 xi, __m512 yi, __m512 zi) {
-  const __m512 zero = _mm512_setzero_ps();
   Pairs q;
   q.m = lanes(k, end);
   q.j = _mm512_maskz_loadu_epi32(q.m, in.index + k);
-  const __m512i j3 = _mm512_add_epi32(q.j, _mm512_add_epi32(q.j, q.j));
-  q.rx = sub(xi, _mm512_mask_i32gather_ps(zero, q.m, j3, in.X, 4));
-  q.ry = sub(yi, _mm512_mask_i32gather_ps(zero, q.m, j3, in.X + 1, 4));
-  q.rz = sub(zi, _mm512_mask_i32gather_ps(zero, q.m, j3, in.X + 2, 4));
+  __m512 xj, yj, zj;
+  neighbourPositions(in, k, q.m, q.j, xj, yj, zj);
+  q.rx = sub(xi, xj);
+  q.ry = sub(yi, yj);
+  q.rz = sub(zi, zj);
   q.r2 = add(add(mul(q.rx, q.rx), mul(q.ry, q.ry)), mul(q.rz, q.rz));
   return q;
 }
@@ -455,10 +488,9 @@ inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1,
       const __mmask16 push = _mm512_mask_cmpeq_epi32_mask(m, ph, _mm512_set1_epi32(kWaterPhase)) &
                              _mm512_cmp_ps_mask(li, zero, _CMP_NEQ_UQ);
       if (!push) continue;
-      const __m512i i3 = _mm512_add_epi32(i, _mm512_add_epi32(i, i));
-      const __m512 rx = sub(_mm512_mask_i32gather_ps(zero, push, i3, X, 4), vx);
-      const __m512 ry = sub(_mm512_mask_i32gather_ps(zero, push, i3, X + 1, 4), vy);
-      const __m512 rz = sub(_mm512_mask_i32gather_ps(zero, push, i3, X + 2, 4), vz);
+      __m512 xi, yi, zi;  // every lane's: those that do not push get mi = 0 and a masked kernel
+      neighbourPositions(in, k, m, i, xi, yi, zi);
+      const __m512 rx = sub(xi, vx), ry = sub(yi, vy), rz = sub(zi, vz);
       const __m512 mi = _mm512_mask_i32gather_ps(zero, push, i, in.mass, 4);
       const Kernel kern = kernelOf<U>(in, push, i, hb);
       const __m512 r2 = add(add(mul(rx, rx), mul(ry, ry)), mul(rz, rz));
@@ -528,7 +560,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const uint8_t* const mixed = s.mixedRadius.data();
   const uint8_t* const plain = s.plain.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
-                nb.index.data(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
+                nb.index.data(), nb.index.size(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
   in.plainM = wp.particleMass;
   in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
   // the pair cache: 12 bytes a pair of the water's lists (16 with artificial pressure, whose s_corr
