@@ -168,12 +168,10 @@ struct PairInputs {
   float invRho0;
   float sCorrK, oneMinusDq2;
   int tensileN;
-  // the pair cache (FluidScratch::pairG*): the lambda pass writes m_j sf_ij r_ij and |r_ij|^2 (only
+  // the pair cache (FluidScratch::pairG, pairR2): the lambda pass writes m_j sf_ij and |r_ij|^2 (only
   // with artificial pressure; cacheR2 null without) of list entry k at [k - cacheBase], the correction
   // pass of the same iteration reads them; null when off
-  float* cacheGx = nullptr;
-  float* cacheGy = nullptr;
-  float* cacheGz = nullptr;
+  float* cacheG = nullptr;
   float* cacheR2 = nullptr;
   uint32_t cacheBase = 0;
   float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markNeighbourhoods)
@@ -338,12 +336,10 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
       sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
       const __m512 sf = spikyFactor(kern, r2, m), f = mul(mul(mj, set(in.invRho0)), sf);
-      if (in.cacheGx) {  // m_j sf r for the correction pass
+      if (in.cacheG) {  // m_j sf for the correction pass
         const __m512 g = mul(mj, sf);
         const uint32_t at = k - in.cacheBase;
-        _mm512_mask_storeu_ps(in.cacheGx + at, m, mul(g, rx));
-        _mm512_mask_storeu_ps(in.cacheGy + at, m, mul(g, ry));
-        _mm512_mask_storeu_ps(in.cacheGz + at, m, mul(g, rz));
+        _mm512_mask_storeu_ps(in.cacheG + at, m, g);
         if (in.cacheR2) _mm512_mask_storeu_ps(in.cacheR2 + at, m, r2);
       }
       sGx = add(sGx, mul(f, rx));
@@ -362,10 +358,10 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
     const float mj = in.M[j];
     r += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
     const float sf = spikyFactorOf(kh, spikyCoefOf(kinv), r2), f = mj * in.invRho0 * sf;
-    if (in.cacheGx) {
+    if (in.cacheG) {
       const float g = mj * sf;
       const uint32_t at = k - in.cacheBase;
-      in.cacheGx[at] = g * rx, in.cacheGy[at] = g * ry, in.cacheGz[at] = g * rz;
+      in.cacheG[at] = g;
       if (in.cacheR2) in.cacheR2[at] = r2;
     }
     gx += f * rx;
@@ -378,29 +374,35 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
   sumOthers = so;
 }
 
-// the correction pass from the pair cache: sum_j (lambda_i + lambda_j + s_corr) (m_j sf_ij r_ij), the
-// pairs' geometry as the lambda pass of this iteration left it (the positions have not moved since)
+// the correction pass from the pair cache: sum_j (lambda_i + lambda_j + s_corr) (m_j sf_ij r_ij), m_j sf_ij
+// as the lambda pass of this iteration left it and r_ij from the positions (which have not moved since:
+// the same r_ij). Caching r_ij too (12 bytes a pair, not 4) was no faster (docs/performance.md, session 12)
 template <bool U, bool Tensile>
 inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
   const float hi = in.H[i], li = in.L[i];
   float dx = 0.0f, dy = 0.0f, dz = 0.0f;
+  const float* X = in.X;
+  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
   uint32_t k = k0;
 #if defined(__AVX512F__)
   if (k1 - k0 >= kSimdMinPairs) {
     using namespace v16;
     const __m512 vli = set(li), zero = _mm512_setzero_ps();
+    const __m512 vx = set(xi), vy = set(yi), vz = set(zi);
     __m512 sx = zero, sy = zero, sz = zero;
     for (; k < k1; k += 16) {
-      const __mmask16 m = lanes(k, k1);
+      const Pairs q = pairsAt(in, k, k1, vx, vy, vz);
+      const __mmask16 m = q.m;
       const uint32_t at = k - in.cacheBase;
-      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k);
+      const __m512i j = q.j;
       const __m512 lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
       __m512 sc = zero;
       if (Tensile) sc = sCorr(in, kernelOf<U>(in, m, j, hi), _mm512_maskz_loadu_ps(m, in.cacheR2 + at), m, j);
       const __m512 lam = add(add(vli, lj), sc);
-      sx = add(sx, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGx + at)));
-      sy = add(sy, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGy + at)));
-      sz = add(sz, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGz + at)));
+      const __m512 g = _mm512_maskz_loadu_ps(m, in.cacheG + at);
+      sx = add(sx, mul(lam, mul(g, q.rx)));
+      sy = add(sy, mul(lam, mul(g, q.ry)));
+      sz = add(sz, mul(lam, mul(g, q.rz)));
     }
     dx = sum(sx), dy = sum(sy), dz = sum(sz);
     k = k1;
@@ -413,9 +415,10 @@ inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uin
                          ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, in.cacheR2[at], kh * kh)
                          : 0.0f;
     const float lam = li + in.L[j] + sc;
-    dx += lam * in.cacheGx[at];
-    dy += lam * in.cacheGy[at];
-    dz += lam * in.cacheGz[at];
+    const float g = in.cacheG[at];
+    dx += lam * (g * (xi - X[3 * j]));
+    dy += lam * (g * (yi - X[3 * j + 1]));
+    dz += lam * (g * (zi - X[3 * j + 2]));
   }
   return Vec3(dx, dy, dz);
 }
@@ -424,7 +427,7 @@ inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uin
 // neighbour has lambda 0 and no s_corr)
 template <bool U, bool Tensile>
 inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
-  if (in.cacheGx) return cachedCorrectionSum<U, Tensile>(in, i, k0, k1);
+  if (in.cacheG) return cachedCorrectionSum<U, Tensile>(in, i, k0, k1);
   const float* X = in.X;
   const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = in.H[i], li = in.L[i];
   float dx = 0.0f, dy = 0.0f, dz = 0.0f;
@@ -563,15 +566,15 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
                 nb.index.data(), nb.index.size(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
   in.plainM = wp.particleMass;
   in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
-  // the pair cache: 12 bytes a pair of the water's lists (16 with artificial pressure, whose s_corr
+  // the pair cache: 4 bytes a pair of the water's lists (8 with artificial pressure, whose s_corr
   // needs |r|^2), when that fits s.pairCacheLimit (not the 1M-particle block: its memory target). It
-  // spares the correction pass four gathers, a square root and a division a pair
+  // spares the correction pass three gathers, a square root and a division a pair
   const size_t waterPairs = nb.start[n] - nb.start[static_cast<size_t>(nc)];
   const bool tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
-  if (waterPairs * (tensile ? 4 : 3) * sizeof(float) <= s.pairCacheLimit) {
-    for (std::vector<float>* v : {&s.pairGx, &s.pairGy, &s.pairGz}) v->resize(waterPairs);
+  if (waterPairs * (tensile ? 2 : 1) * sizeof(float) <= s.pairCacheLimit) {
+    s.pairG.resize(waterPairs);
     s.pairR2.resize(tensile ? waterPairs : 0);
-    in.cacheGx = s.pairGx.data(), in.cacheGy = s.pairGy.data(), in.cacheGz = s.pairGz.data();
+    in.cacheG = s.pairG.data();
     in.cacheR2 = tensile ? s.pairR2.data() : nullptr;  // unread by the correction pass without s_corr
     in.cacheBase = nb.start[static_cast<size_t>(nc)];
   }
