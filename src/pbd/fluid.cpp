@@ -175,6 +175,7 @@ struct PairInputs {
   float* cacheR2 = nullptr;
   uint32_t cacheBase = 0;
   float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markNeighbourhoods)
+  const float* MWH = nullptr;  // M, W and H again as one 4-float record a particle (FluidScratch::records)
 };
 
 #if defined(__AVX512F__)
@@ -205,8 +206,12 @@ struct Pairs {
 // fourth float masked off, so the last record reads nothing past the array) and a 4 x 4 transpose in
 // each 128-bit quarter. On AMD Zen 4 three gathers cost about 1.5x as much (docs/performance.md,
 // session 12); the values are the same
+template <int Stride = 3>
 inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& y, __m512& z) {
-  const auto at = [&](int l) { return _mm_maskz_loadu_ps(__mmask8(0x7), X + 3 * static_cast<size_t>(idx[l])); };
+  // 3 floats a record: the fourth masked off; 4: whole records (the fourth row is dropped)
+  const auto at = [&](int l) {
+    return _mm_maskz_loadu_ps(__mmask8(Stride == 3 ? 0x7 : 0xF), X + Stride * static_cast<size_t>(idx[l]));
+  };
   __m512 a = _mm512_castps128_ps512(at(0)), b = _mm512_castps128_ps512(at(1));
   __m512 c = _mm512_castps128_ps512(at(2)), d = _mm512_castps128_ps512(at(3));
   a = _mm512_insertf32x4(a, at(4), 1), b = _mm512_insertf32x4(b, at(5), 1);
@@ -227,11 +232,16 @@ inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& 
 // positionsOf the lanes' neighbours index[k ..), lanes m: past the list's end the lanes read the next
 // lists' neighbours (valid particles, masked by the callers); at the end of the index array they read
 // particle 0. A copy of the lanes would be slower: its scalar loads wait for the vector store
-inline void neighbourPositions(const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x, __m512& y, __m512& z) {
-  if (k + 16 <= in.indexSize) return positionsOf(in.X, in.index + k, x, y, z);
+template <int Stride = 3>
+inline void neighbourRecords(const float* X, const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x,
+                             __m512& y, __m512& z) {
+  if (k + 16 <= in.indexSize) return positionsOf<Stride>(X, in.index + k, x, y, z);
   alignas(64) uint32_t copy[16];
   _mm512_store_si512(copy, _mm512_maskz_mov_epi32(m, j));
-  positionsOf(in.X, copy, x, y, z);
+  positionsOf<Stride>(X, copy, x, y, z);
+}
+inline void neighbourPositions(const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x, __m512& y, __m512& z) {
+  neighbourRecords(in.X, in, k, m, j, x, y, z);
 }
 inline Pairs pairsAt(const PairInputs& in, uint32_t k, uint32_t end, __m512 xi, __m512 yi, __m512 zi) {
   Pairs q;
@@ -252,14 +262,17 @@ inline __m512 gatherOf(const Pairs& q, const float* a) { return _mm512_mask_i32g
 struct Kernel {
   __m512 h, h2, poly6, spiky;
 };
-template <bool U>
-inline Kernel kernelOf(const PairInputs& in, __mmask16 m, __m512i j, float hi) {
-  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOf(in.invU)), set(spikyCoefOf(in.invU))};
-  const __m512 hj = _mm512_mask_i32gather_ps(set(hi), m, j, in.H, 4);
+// the per-pair radius case from h_j (hi in the masked lanes)
+inline Kernel kernelOfRadius(float hi, __m512 hj) {
   const __m512 h = mul(set(0.5f), add(set(hi), hj));
   const __m512 inv = _mm512_div_ps(set(1.0f), h);
   const __m512 inv3 = mul(mul(inv, inv), inv), inv6 = mul(inv3, inv3);
   return {h, mul(h, h), mul(mul(set(315.0f / (64.0f * kPi)), inv6), inv3), mul(set(-45.0f / kPi), inv6)};
+}
+template <bool U>
+inline Kernel kernelOf(const PairInputs& in, __mmask16 m, __m512i j, float hi) {
+  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOf(in.invU)), set(spikyCoefOf(in.invU))};
+  return kernelOfRadius(hi, _mm512_mask_i32gather_ps(set(hi), m, j, in.H, 4));
 }
 // spikyFactorOf per lane, 0 outside the support, at r = 0 and in masked lanes
 inline __m512 spikyFactor(const Kernel& k, __m512 r2, __mmask16 m) {
@@ -330,9 +343,17 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const __m512i j = q.j;
       const __m512 rx = q.rx, ry = q.ry, rz = q.rz, r2 = q.r2;
       // plain (markNeighbourhoods): every neighbour's m_j and w_j are the constants, 0 past the list's end as gathered
-      const __m512 mj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainM)) : gatherOf(q, in.M);
-      const __m512 wj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainW)) : gatherOf(q, in.W);
-      const Kernel kern = kernelOf<U>(in, m, j, hi);
+      __m512 mj, wj;
+      Kernel kern;
+      if (Plain) {
+        mj = _mm512_maskz_mov_ps(m, set(in.plainM)), wj = _mm512_maskz_mov_ps(m, set(in.plainW));
+        kern = kernelOf<true>(in, m, j, hi);
+      } else {  // m_j, w_j, h_j from one record (0, 0, h_i past the list's end, as the gathers gave)
+        __m512 rm, rw, rh;
+        neighbourRecords<4>(in.MWH, in, k, m, j, rm, rw, rh);
+        mj = _mm512_maskz_mov_ps(m, rm), wj = _mm512_maskz_mov_ps(m, rw);
+        kern = U ? kernelOf<true>(in, m, j, hi) : kernelOfRadius(hi, _mm512_mask_mov_ps(set(hi), m, rh));
+      }
       const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
       sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
       const __m512 sf = spikyFactor(kern, r2, m), f = mul(mul(mj, set(in.invRho0)), sf);
@@ -553,6 +574,13 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   }
   // the mass a neighbour lends the density: its own for water, the boundary mass Psi_b for cloth
   parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.massOrPsi[j] = j < nc ? s.psi[j] : p.mass[j]; });
+#if defined(__AVX512F__)
+  s.records.resize(4 * n);  // what the density pass reads of a neighbour that is not plain, in one load
+  parallelFor(static_cast<int64_t>(n), [&](int64_t j) {
+    float* r = s.records.data() + 4 * j;
+    r[0] = s.massOrPsi[j], r[1] = p.invMass[j], r[2] = p.radius[j], r[3] = 0.0f;
+  });
+#endif
   const float* H = p.radius.data();
   const float* L = s.lambda.data();
   float hU = 0.0f;
@@ -564,6 +592,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const uint8_t* const plain = s.plain.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
                 nb.index.data(), nb.index.size(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
+  in.MWH = s.records.data();
   in.plainM = wp.particleMass;
   in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
   // the pair cache: 4 bytes a pair of the water's lists (8 with artificial pressure, whose s_corr

@@ -20,6 +20,8 @@ struct FluidScratch {
   std::vector<Vec3> vorticity;     // 1/s, omega_i
   std::vector<float> vorticityNorm; // 1/s, |omega_i| (0 for cloth)
   std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
+  std::vector<float> records;      // AVX-512 builds: massOrPsi, inverse mass and radius of each particle, 4 floats
+                                   // a particle (the fourth 0), one load for the density pass
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
   std::vector<float> wallClear;    // m, per water particle: a lower bound of its distance to the nearest part at wallFrom
