@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
+#include <tuple>
 
 #include "core/parallel.hpp"
 
@@ -196,27 +198,30 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   constexpr int kPiece = 256;
   scratch.correction.resize(static_cast<size_t>(threadCount()) * 6 * kPiece);
   scratch.correctionBend.resize(static_cast<size_t>(threadCount()) * 12 * kPiece);
-  const auto stretchBlock = [&](int begin, int end, float* corr) {
+  // constraints [begin, end) of one colour (vertices ids[k]), kPiece at a time: range(b0, b1) writes
+  // their moves to corr (three rows a vertex, kPiece apart), which are then added to the vertices
+  const auto inPieces = [&](int begin, int end, float* corr, const auto& ids, auto&& range) {
+    constexpr int nv = static_cast<int>(std::tuple_size_v<typename std::decay_t<decltype(ids)>::value_type>);
     for (int b0 = begin; b0 < end; b0 += kPiece) {
       const int b1 = std::min(end, b0 + kPiece);
-      stretchRange(b0, b1, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
-                   stretchLambda, corr, kPiece);
+      range(b0, b1);
       for (int k = b0; k < b1; ++k)
-        for (int v = 0; v < 2; ++v)
-          x[st.ids[k][v]] += Vec3(corr[(3 * v) * kPiece + k - b0], corr[(3 * v + 1) * kPiece + k - b0],
-                                  corr[(3 * v + 2) * kPiece + k - b0]);
+        for (int v = 0; v < nv; ++v)
+          x[ids[k][v]] += Vec3(corr[(3 * v) * kPiece + k - b0], corr[(3 * v + 1) * kPiece + k - b0],
+                               corr[(3 * v + 2) * kPiece + k - b0]);
     }
   };
+  const auto stretchBlock = [&](int begin, int end, float* corr) {
+    inPieces(begin, end, corr, st.ids, [&](int b0, int b1) {
+      stretchRange(b0, b1, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
+                   stretchLambda, corr, kPiece);
+    });
+  };
   const auto bendBlock = [&](int begin, int end, float* corr) {
-    for (int b0 = begin; b0 < end; b0 += kPiece) {
-      const int b1 = std::min(end, b0 + kPiece);
+    inPieces(begin, end, corr, bd.ids, [&](int b0, int b1) {
       bendRange(b0, b1, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
                 bendLambda, corr, kPiece);
-      for (int k = b0; k < b1; ++k)
-        for (int v = 0; v < 4; ++v)
-          x[bd.ids[k][v]] += Vec3(corr[(3 * v) * kPiece + k - b0], corr[(3 * v + 1) * kPiece + k - b0],
-                                  corr[(3 * v + 2) * kPiece + k - b0]);
-    }
+    });
   };
   // one group: its stretch constraints colour by colour, then its bend constraints
   const ConstraintSchedule& ss = st.schedule;

@@ -202,13 +202,13 @@ struct Pairs {
   __m512i j;
   __m512 rx, ry, rz, r2;
 };
-// x, y, z of the 16 particles idx[0 .. 16) from 3-float records: one 128-bit load a particle (its
+// the first three floats of the records of the 16 particles idx[0 .. 16) (Stride floats a record: x, y, z
+// of the positions; m, w, h of FluidScratch::records): one 128-bit load a particle (a 3-float record's
 // fourth float masked off, so the last record reads nothing past the array) and a 4 x 4 transpose in
 // each 128-bit quarter. On AMD Zen 4 three gathers cost about 1.5x as much (docs/performance.md,
 // session 12); the values are the same
 template <int Stride = 3>
 inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& y, __m512& z) {
-  // 3 floats a record: the fourth masked off; 4: whole records (the fourth row is dropped)
   const auto at = [&](int l) {
     return _mm_maskz_loadu_ps(__mmask8(Stride == 3 ? 0x7 : 0xF), X + Stride * static_cast<size_t>(idx[l]));
   };
@@ -229,7 +229,7 @@ inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& 
   y = _mm512_maskz_shuffle_ps(all, t0, t2, 0xEE);
   z = _mm512_maskz_shuffle_ps(all, t1, t3, 0x44);
 }
-// positionsOf the lanes' neighbours index[k ..), lanes m: past the list's end the lanes read the next
+// positionsOf the lanes' neighbours index[k ..) in X, lanes m: past the list's end the lanes read the next
 // lists' neighbours (valid particles, masked by the callers); at the end of the index array they read
 // particle 0. A copy of the lanes would be slower: its scalar loads wait for the vector store
 template <int Stride = 3>
