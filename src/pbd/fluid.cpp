@@ -168,11 +168,9 @@ struct PairInputs {
   float invRho0;
   float sCorrK, oneMinusDq2;
   int tensileN;
-  // the pair cache (FluidScratch::pairG, pairR2): the lambda pass writes m_j sf_ij and |r_ij|^2 (only
-  // with artificial pressure; cacheR2 null without) of list entry k at [k - cacheBase], the correction
-  // pass of the same iteration reads them; null when off
+  // the pair cache (FluidScratch::pairG): the lambda pass writes m_j sf_ij of list entry k at
+  // [k - cacheBase], the correction pass of the same iteration reads it; null when off
   float* cacheG = nullptr;
-  float* cacheR2 = nullptr;
   uint32_t cacheBase = 0;
   float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markNeighbourhoods)
   const float* MWH = nullptr;  // M, W and H again as one 4-float record a particle (FluidScratch::records)
@@ -361,7 +359,6 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
         const __m512 g = mul(mj, sf);
         const uint32_t at = k - in.cacheBase;
         _mm512_mask_storeu_ps(in.cacheG + at, m, g);
-        if (in.cacheR2) _mm512_mask_storeu_ps(in.cacheR2 + at, m, r2);
       }
       sGx = add(sGx, mul(f, rx));
       sGy = add(sGy, mul(f, ry));
@@ -383,7 +380,6 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const float g = mj * sf;
       const uint32_t at = k - in.cacheBase;
       in.cacheG[at] = g;
-      if (in.cacheR2) in.cacheR2[at] = r2;
     }
     gx += f * rx;
     gy += f * ry;
@@ -418,7 +414,7 @@ inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uin
       const __m512i j = q.j;
       const __m512 lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
       __m512 sc = zero;
-      if (Tensile) sc = sCorr(in, kernelOf<U>(in, m, j, hi), _mm512_maskz_loadu_ps(m, in.cacheR2 + at), m, j);
+      if (Tensile) sc = sCorr(in, kernelOf<U>(in, m, j, hi), q.r2, m, j);
       const __m512 lam = add(add(vli, lj), sc);
       const __m512 g = _mm512_maskz_loadu_ps(m, in.cacheG + at);
       sx = add(sx, mul(lam, mul(g, q.rx)));
@@ -430,16 +426,15 @@ inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uin
   }
 #endif
   for (; k < k1; ++k) {
-    const uint32_t j = in.index[k], at = k - in.cacheBase;
-    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]);
+    const auto [j, rx, ry, rz, r2, kh, kinv] = scalarPair<U>(in, k, xi, yi, zi, hi);
     const float sc = Tensile && in.phase[j] == kWaterPhase
-                         ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, in.cacheR2[at], kh * kh)
+                         ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, r2, kh * kh)
                          : 0.0f;
     const float lam = li + in.L[j] + sc;
-    const float g = in.cacheG[at];
-    dx += lam * (g * (xi - X[3 * j]));
-    dy += lam * (g * (yi - X[3 * j + 1]));
-    dz += lam * (g * (zi - X[3 * j + 2]));
+    const float g = in.cacheG[k - in.cacheBase];
+    dx += lam * (g * rx);
+    dy += lam * (g * ry);
+    dz += lam * (g * rz);
   }
   return Vec3(dx, dy, dz);
 }
@@ -595,16 +590,14 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   in.MWH = s.records.data();
   in.plainM = wp.particleMass;
   in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
-  // the pair cache: 4 bytes a pair of the water's lists (8 with artificial pressure, whose s_corr
-  // needs |r|^2), when that fits s.pairCacheLimit (not the 1M-particle block: its memory target). It
-  // spares the correction pass three gathers, a square root and a division a pair
+  // the pair cache: 4 bytes a pair of the water's lists, when that fits s.pairCacheLimit (not the
+  // 1M-particle block: its memory target). It spares the correction pass three gathers, a square root
+  // and a division a pair
   const size_t waterPairs = nb.start[n] - nb.start[static_cast<size_t>(nc)];
   const bool tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
-  if (waterPairs * (tensile ? 2 : 1) * sizeof(float) <= s.pairCacheLimit) {
+  if (waterPairs * sizeof(float) <= s.pairCacheLimit) {
     s.pairG.resize(waterPairs);
-    s.pairR2.resize(tensile ? waterPairs : 0);
     in.cacheG = s.pairG.data();
-    in.cacheR2 = tensile ? s.pairR2.data() : nullptr;  // unread by the correction pass without s_corr
     in.cacheBase = nb.start[static_cast<size_t>(nc)];
   }
   const auto solve = [&](auto uniform, auto tensile) {

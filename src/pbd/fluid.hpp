@@ -30,9 +30,9 @@ struct FluidScratch {
   std::vector<Vec3> wallFrom;      // m, where each water particle was when wallClear was measured
   // per entry of the water particles' neighbour lists, written by the lambda pass and read by the
   // correction pass of the same iteration: m_j sf_ij (kg/m^5, the spiky gradient's factor sf: grad W_ij =
-  // sf_ij r_ij) and |r_ij|^2 (m^2, only with artificial pressure: pairR2 is empty without); used only
-  // while the arrays take at most pairCacheLimit bytes (the 1M-particle block's 33M pairs do not)
-  std::vector<float> pairG, pairR2;
+  // sf_ij r_ij); used only while it takes at most pairCacheLimit bytes (the 1M-particle block's 33M
+  // pairs do not)
+  std::vector<float> pairG;
   size_t pairCacheLimit = size_t(96) << 20;
 };
 
