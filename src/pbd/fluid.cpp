@@ -540,6 +540,10 @@ inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1,
 
 }  // namespace
 
+// water particles a chunk of the solver's dynamically scheduled passes: against static halves -7 to
+// -15 % (Figs. 5(c), 9(b)); chunks of 256 were slower than static halves, 2048 about as 1024
+constexpr int64_t kWaterPassChunk = 1024;
+
 // The solver's neighbour loops are densitySums, correctionSum and reactionSum above (AVX-512 by hand
 // where available); the velocity pass below is scalar (once a substep).
 void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
@@ -603,8 +607,10 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const auto solve = [&](auto uniform, auto tensile) {
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (int it = 0; it < iterations; ++it) {
-      // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7)
-      parallelFor(nw, [&](int64_t w) {
+      // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7).
+      // Chunks of kWaterPassChunk to whichever thread is free: the water by the cloth, the smaller
+      // particles and the surface cost more a particle than the pool's (docs/performance.md, session 12)
+      parallelForDynamic(nw, kWaterPassChunk, [&](int64_t w) {
         const size_t i = static_cast<size_t>(nc + w);
         const float hi = H[i], mi = p.mass[i];
         float rho = 0.0f, sumOthers = 0.0f;  // sumOthers: sum over neighbours of w_k |grad_k C|^2
@@ -632,7 +638,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       });
       // water corrections: dx_i = 1/rho0 sum_j m_j (lambda_i + lambda_j + s_corr) grad W_ij (+ boundaries);
       // a cloth neighbour has lambda 0 and no s_corr: Psi_b lambda_i grad W_ib
-      parallelFor(nw, [&](int64_t w) {
+      parallelForDynamic(nw, kWaterPassChunk, [&](int64_t w) {
         const size_t i = static_cast<size_t>(nc + w);
         const Vec3 sumJ = U || !mixed[i] ? correctionSum<true, Tensile>(in, i, nb.start[i], nb.start[i + 1])
                                          : correctionSum<false, Tensile>(in, i, nb.start[i], nb.start[i + 1]);
