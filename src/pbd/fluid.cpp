@@ -168,12 +168,15 @@ struct PairInputs {
   float invRho0;
   float sCorrK, oneMinusDq2;
   int tensileN;
-  // the pair cache (FluidScratch::pairG): the lambda pass writes m_j sf_ij of list entry k at
-  // [k - cacheBase], the correction pass of the same iteration reads it; null when off
-  float* cacheG = nullptr;
+  // the pair cache (FluidScratch::pairG*): the lambda pass writes m_j sf_ij r_ij and |r_ij|^2 (only
+  // with artificial pressure; cacheR2 null without) of list entry k at [k - cacheBase], the correction
+  // pass of the same iteration reads them; null when off
+  float* cacheGx = nullptr;
+  float* cacheGy = nullptr;
+  float* cacheGz = nullptr;
+  float* cacheR2 = nullptr;
   uint32_t cacheBase = 0;
   float plainM = 0.0f, plainW = 0.0f;  // m_j and w_j of a plain particle's neighbours (markNeighbourhoods)
-  const float* MWH = nullptr;  // M, W and H again as one 4-float record a particle (FluidScratch::records)
 };
 
 #if defined(__AVX512F__)
@@ -200,16 +203,12 @@ struct Pairs {
   __m512i j;
   __m512 rx, ry, rz, r2;
 };
-// the first three floats of the records of the 16 particles idx[0 .. 16) (Stride floats a record: x, y, z
-// of the positions; m, w, h of FluidScratch::records): one 128-bit load a particle (a 3-float record's
+// x, y, z of the 16 particles idx[0 .. 16) from 3-float records: one 128-bit load a particle (its
 // fourth float masked off, so the last record reads nothing past the array) and a 4 x 4 transpose in
 // each 128-bit quarter. On AMD Zen 4 three gathers cost about 1.5x as much (docs/performance.md,
 // session 12); the values are the same
-template <int Stride = 3>
 inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& y, __m512& z) {
-  const auto at = [&](int l) {
-    return _mm_maskz_loadu_ps(__mmask8(Stride == 3 ? 0x7 : 0xF), X + Stride * static_cast<size_t>(idx[l]));
-  };
+  const auto at = [&](int l) { return _mm_maskz_loadu_ps(__mmask8(0x7), X + 3 * static_cast<size_t>(idx[l])); };
   __m512 a = _mm512_castps128_ps512(at(0)), b = _mm512_castps128_ps512(at(1));
   __m512 c = _mm512_castps128_ps512(at(2)), d = _mm512_castps128_ps512(at(3));
   a = _mm512_insertf32x4(a, at(4), 1), b = _mm512_insertf32x4(b, at(5), 1);
@@ -227,19 +226,14 @@ inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& 
   y = _mm512_maskz_shuffle_ps(all, t0, t2, 0xEE);
   z = _mm512_maskz_shuffle_ps(all, t1, t3, 0x44);
 }
-// positionsOf the lanes' neighbours index[k ..) in X, lanes m: past the list's end the lanes read the next
+// positionsOf the lanes' neighbours index[k ..), lanes m: past the list's end the lanes read the next
 // lists' neighbours (valid particles, masked by the callers); at the end of the index array they read
 // particle 0. A copy of the lanes would be slower: its scalar loads wait for the vector store
-template <int Stride = 3>
-inline void neighbourRecords(const float* X, const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x,
-                             __m512& y, __m512& z) {
-  if (k + 16 <= in.indexSize) return positionsOf<Stride>(X, in.index + k, x, y, z);
+inline void neighbourPositions(const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x, __m512& y, __m512& z) {
+  if (k + 16 <= in.indexSize) return positionsOf(in.X, in.index + k, x, y, z);
   alignas(64) uint32_t copy[16];
   _mm512_store_si512(copy, _mm512_maskz_mov_epi32(m, j));
-  positionsOf<Stride>(X, copy, x, y, z);
-}
-inline void neighbourPositions(const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x, __m512& y, __m512& z) {
-  neighbourRecords(in.X, in, k, m, j, x, y, z);
+  positionsOf(in.X, copy, x, y, z);
 }
 inline Pairs pairsAt(const PairInputs& in, uint32_t k, uint32_t end, __m512 xi, __m512 yi, __m512 zi) {
   Pairs q;
@@ -260,17 +254,14 @@ inline __m512 gatherOf(const Pairs& q, const float* a) { return _mm512_mask_i32g
 struct Kernel {
   __m512 h, h2, poly6, spiky;
 };
-// the per-pair radius case from h_j (hi in the masked lanes)
-inline Kernel kernelOfRadius(float hi, __m512 hj) {
+template <bool U>
+inline Kernel kernelOf(const PairInputs& in, __mmask16 m, __m512i j, float hi) {
+  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOf(in.invU)), set(spikyCoefOf(in.invU))};
+  const __m512 hj = _mm512_mask_i32gather_ps(set(hi), m, j, in.H, 4);
   const __m512 h = mul(set(0.5f), add(set(hi), hj));
   const __m512 inv = _mm512_div_ps(set(1.0f), h);
   const __m512 inv3 = mul(mul(inv, inv), inv), inv6 = mul(inv3, inv3);
   return {h, mul(h, h), mul(mul(set(315.0f / (64.0f * kPi)), inv6), inv3), mul(set(-45.0f / kPi), inv6)};
-}
-template <bool U>
-inline Kernel kernelOf(const PairInputs& in, __mmask16 m, __m512i j, float hi) {
-  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOf(in.invU)), set(spikyCoefOf(in.invU))};
-  return kernelOfRadius(hi, _mm512_mask_i32gather_ps(set(hi), m, j, in.H, 4));
 }
 // spikyFactorOf per lane, 0 outside the support, at r = 0 and in masked lanes
 inline __m512 spikyFactor(const Kernel& k, __m512 r2, __mmask16 m) {
@@ -341,24 +332,19 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
       const __m512i j = q.j;
       const __m512 rx = q.rx, ry = q.ry, rz = q.rz, r2 = q.r2;
       // plain (markNeighbourhoods): every neighbour's m_j and w_j are the constants, 0 past the list's end as gathered
-      __m512 mj, wj;
-      Kernel kern;
-      if (Plain) {
-        mj = _mm512_maskz_mov_ps(m, set(in.plainM)), wj = _mm512_maskz_mov_ps(m, set(in.plainW));
-        kern = kernelOf<true>(in, m, j, hi);
-      } else {  // m_j, w_j, h_j from one record (0, 0, h_i past the list's end, as the gathers gave)
-        __m512 rm, rw, rh;
-        neighbourRecords<4>(in.MWH, in, k, m, j, rm, rw, rh);
-        mj = _mm512_maskz_mov_ps(m, rm), wj = _mm512_maskz_mov_ps(m, rw);
-        kern = U ? kernelOf<true>(in, m, j, hi) : kernelOfRadius(hi, _mm512_mask_mov_ps(set(hi), m, rh));
-      }
+      const __m512 mj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainM)) : gatherOf(q, in.M);
+      const __m512 wj = Plain ? _mm512_maskz_mov_ps(m, set(in.plainW)) : gatherOf(q, in.W);
+      const Kernel kern = kernelOf<U>(in, m, j, hi);
       const __m512 d = _mm512_maskz_max_ps(__mmask16(0xFFFF), sub(kern.h2, r2), zero);
       sRho = add(sRho, mul(mj, mul(mul(mul(kern.poly6, d), d), d)));
       const __m512 sf = spikyFactor(kern, r2, m), f = mul(mul(mj, set(in.invRho0)), sf);
-      if (in.cacheG) {  // m_j sf for the correction pass
+      if (in.cacheGx) {  // m_j sf r for the correction pass
         const __m512 g = mul(mj, sf);
         const uint32_t at = k - in.cacheBase;
-        _mm512_mask_storeu_ps(in.cacheG + at, m, g);
+        _mm512_mask_storeu_ps(in.cacheGx + at, m, mul(g, rx));
+        _mm512_mask_storeu_ps(in.cacheGy + at, m, mul(g, ry));
+        _mm512_mask_storeu_ps(in.cacheGz + at, m, mul(g, rz));
+        if (in.cacheR2) _mm512_mask_storeu_ps(in.cacheR2 + at, m, r2);
       }
       sGx = add(sGx, mul(f, rx));
       sGy = add(sGy, mul(f, ry));
@@ -376,10 +362,11 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
     const float mj = in.M[j];
     r += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
     const float sf = spikyFactorOf(kh, spikyCoefOf(kinv), r2), f = mj * in.invRho0 * sf;
-    if (in.cacheG) {
+    if (in.cacheGx) {
       const float g = mj * sf;
       const uint32_t at = k - in.cacheBase;
-      in.cacheG[at] = g;
+      in.cacheGx[at] = g * rx, in.cacheGy[at] = g * ry, in.cacheGz[at] = g * rz;
+      if (in.cacheR2) in.cacheR2[at] = r2;
     }
     gx += f * rx;
     gy += f * ry;
@@ -391,50 +378,44 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
   sumOthers = so;
 }
 
-// the correction pass from the pair cache: sum_j (lambda_i + lambda_j + s_corr) (m_j sf_ij r_ij), m_j sf_ij
-// as the lambda pass of this iteration left it and r_ij from the positions (which have not moved since:
-// the same r_ij). Caching r_ij too (12 bytes a pair, not 4) was no faster (docs/performance.md, session 12)
+// the correction pass from the pair cache: sum_j (lambda_i + lambda_j + s_corr) (m_j sf_ij r_ij), the
+// pairs' geometry as the lambda pass of this iteration left it (the positions have not moved since)
 template <bool U, bool Tensile>
 inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
   const float hi = in.H[i], li = in.L[i];
   float dx = 0.0f, dy = 0.0f, dz = 0.0f;
-  const float* X = in.X;
-  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
   uint32_t k = k0;
 #if defined(__AVX512F__)
   if (k1 - k0 >= kSimdMinPairs) {
     using namespace v16;
     const __m512 vli = set(li), zero = _mm512_setzero_ps();
-    const __m512 vx = set(xi), vy = set(yi), vz = set(zi);
     __m512 sx = zero, sy = zero, sz = zero;
     for (; k < k1; k += 16) {
-      const Pairs q = pairsAt(in, k, k1, vx, vy, vz);
-      const __mmask16 m = q.m;
+      const __mmask16 m = lanes(k, k1);
       const uint32_t at = k - in.cacheBase;
-      const __m512i j = q.j;
+      const __m512i j = _mm512_maskz_loadu_epi32(m, in.index + k);
       const __m512 lj = _mm512_mask_i32gather_ps(zero, m, j, in.L, 4);
       __m512 sc = zero;
-      if (Tensile) sc = sCorr(in, kernelOf<U>(in, m, j, hi), q.r2, m, j);
+      if (Tensile) sc = sCorr(in, kernelOf<U>(in, m, j, hi), _mm512_maskz_loadu_ps(m, in.cacheR2 + at), m, j);
       const __m512 lam = add(add(vli, lj), sc);
-      const __m512 g = _mm512_maskz_loadu_ps(m, in.cacheG + at);
-      sx = add(sx, mul(lam, mul(g, q.rx)));
-      sy = add(sy, mul(lam, mul(g, q.ry)));
-      sz = add(sz, mul(lam, mul(g, q.rz)));
+      sx = add(sx, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGx + at)));
+      sy = add(sy, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGy + at)));
+      sz = add(sz, mul(lam, _mm512_maskz_loadu_ps(m, in.cacheGz + at)));
     }
     dx = sum(sx), dy = sum(sy), dz = sum(sz);
     k = k1;
   }
 #endif
   for (; k < k1; ++k) {
-    const auto [j, rx, ry, rz, r2, kh, kinv] = scalarPair<U>(in, k, xi, yi, zi, hi);
+    const uint32_t j = in.index[k], at = k - in.cacheBase;
+    const float kh = U ? in.hU : 0.5f * (hi + in.H[j]);
     const float sc = Tensile && in.phase[j] == kWaterPhase
-                         ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, r2, kh * kh)
+                         ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, in.cacheR2[at], kh * kh)
                          : 0.0f;
     const float lam = li + in.L[j] + sc;
-    const float g = in.cacheG[k - in.cacheBase];
-    dx += lam * (g * rx);
-    dy += lam * (g * ry);
-    dz += lam * (g * rz);
+    dx += lam * in.cacheGx[at];
+    dy += lam * in.cacheGy[at];
+    dz += lam * in.cacheGz[at];
   }
   return Vec3(dx, dy, dz);
 }
@@ -443,7 +424,7 @@ inline Vec3 cachedCorrectionSum(const PairInputs& in, size_t i, uint32_t k0, uin
 // neighbour has lambda 0 and no s_corr)
 template <bool U, bool Tensile>
 inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1) {
-  if (in.cacheG) return cachedCorrectionSum<U, Tensile>(in, i, k0, k1);
+  if (in.cacheGx) return cachedCorrectionSum<U, Tensile>(in, i, k0, k1);
   const float* X = in.X;
   const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = in.H[i], li = in.L[i];
   float dx = 0.0f, dy = 0.0f, dz = 0.0f;
@@ -540,8 +521,8 @@ inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1,
 
 }  // namespace
 
-// water particles a chunk of the solver's dynamically scheduled passes: against static halves -7 to
-// -15 % (Figs. 5(c), 9(b)); chunks of 256 were slower than static halves, 2048 about as 1024
+// water particles a chunk of the solver's dynamically scheduled passes: against static halves -2 to
+// -8 % (Figs. 5(c), 9(b)); chunks of 256 were slower than static halves
 constexpr int64_t kWaterPassChunk = 1024;
 
 // The solver's neighbour loops are densitySums, correctionSum and reactionSum above (AVX-512 by hand
@@ -573,13 +554,6 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   }
   // the mass a neighbour lends the density: its own for water, the boundary mass Psi_b for cloth
   parallelFor(static_cast<int64_t>(n), [&](int64_t j) { s.massOrPsi[j] = j < nc ? s.psi[j] : p.mass[j]; });
-#if defined(__AVX512F__)
-  s.records.resize(4 * n);  // what the density pass reads of a neighbour that is not plain, in one load
-  parallelFor(static_cast<int64_t>(n), [&](int64_t j) {
-    float* r = s.records.data() + 4 * j;
-    r[0] = s.massOrPsi[j], r[1] = p.invMass[j], r[2] = p.radius[j], r[3] = 0.0f;
-  });
-#endif
   const float* H = p.radius.data();
   const float* L = s.lambda.data();
   float hU = 0.0f;
@@ -591,17 +565,18 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const uint8_t* const plain = s.plain.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
                 nb.index.data(), nb.index.size(), hU, 1.0f / hU, invRho0, sCorrK, oneMinusDq2, tensileN};
-  in.MWH = s.records.data();
   in.plainM = wp.particleMass;
   in.plainW = wp.particleMass > 0.0f ? 1.0f / wp.particleMass : 0.0f;
-  // the pair cache: 4 bytes a pair of the water's lists, when that fits s.pairCacheLimit (not the
-  // 1M-particle block: its memory target). It spares the correction pass three gathers, a square root
-  // and a division a pair
+  // the pair cache: 12 bytes a pair of the water's lists (16 with artificial pressure, whose s_corr
+  // needs |r|^2), when that fits s.pairCacheLimit (not the 1M-particle block: its memory target). It
+  // spares the correction pass four gathers, a square root and a division a pair
   const size_t waterPairs = nb.start[n] - nb.start[static_cast<size_t>(nc)];
   const bool tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
-  if (waterPairs * sizeof(float) <= s.pairCacheLimit) {
-    s.pairG.resize(waterPairs);
-    in.cacheG = s.pairG.data();
+  if (waterPairs * (tensile ? 4 : 3) * sizeof(float) <= s.pairCacheLimit) {
+    for (std::vector<float>* v : {&s.pairGx, &s.pairGy, &s.pairGz}) v->resize(waterPairs);
+    s.pairR2.resize(tensile ? waterPairs : 0);
+    in.cacheGx = s.pairGx.data(), in.cacheGy = s.pairGy.data(), in.cacheGz = s.pairGz.data();
+    in.cacheR2 = tensile ? s.pairR2.data() : nullptr;  // unread by the correction pass without s_corr
     in.cacheBase = nb.start[static_cast<size_t>(nc)];
   }
   const auto solve = [&](auto uniform, auto tensile) {

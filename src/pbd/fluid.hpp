@@ -20,8 +20,6 @@ struct FluidScratch {
   std::vector<Vec3> vorticity;     // 1/s, omega_i
   std::vector<float> vorticityNorm; // 1/s, |omega_i| (0 for cloth)
   std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
-  std::vector<float> records;      // AVX-512 builds: massOrPsi, inverse mass and radius of each particle, 4 floats
-                                   // a particle (the fourth 0), one load for the density pass
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
   std::vector<float> wallClear;    // m, per water particle: a lower bound of its distance to the nearest part at wallFrom
@@ -29,11 +27,11 @@ struct FluidScratch {
   std::vector<uint8_t> plain;        // 1: a water particle of water.particleMass whose neighbours all are (markNeighbourhoods)
   std::vector<Vec3> wallFrom;      // m, where each water particle was when wallClear was measured
   // per entry of the water particles' neighbour lists, written by the lambda pass and read by the
-  // correction pass of the same iteration: m_j sf_ij (kg/m^5, the spiky gradient's factor sf: grad W_ij =
-  // sf_ij r_ij); used only while it takes at most pairCacheLimit bytes (the 1M-particle block's 33M
-  // pairs do not)
-  std::vector<float> pairG;
-  size_t pairCacheLimit = size_t(96) << 20;
+  // correction pass of the same iteration: m_j sf_ij r_ij (kg m, the spiky gradient's factor sf) and
+  // |r_ij|^2 (m^2, only with artificial pressure: pairR2 is empty without); used only while the
+  // arrays take at most pairCacheLimit bytes
+  std::vector<float> pairGx, pairGy, pairGz, pairR2;
+  size_t pairCacheLimit = size_t(256) << 20;
 };
 
 // Akinci volume of each cloth particle, V_b = 1 / sum_k W_bk over the same piece (Eq. 10), and
