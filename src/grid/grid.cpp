@@ -452,9 +452,8 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   // part of the sheet has many more neighbours than the rest, so equal halves were unequal work): each
   // chunk gathers into its own buffer, then the buffers are copied to the list in particle order, so
   // the lists do not depend on which thread did what. Rounds of kRound chunks: the buffers hold one
-  // round, not a copy of the lists. Chunks of 1024 particles: 256 took 5 - 15 % longer (Figs. 5(c),
-  // 9(b), docs/performance.md session 12)
-  constexpr size_t kChunk = 1024, kRound = 16;
+  // round, not a copy of the lists.
+  constexpr size_t kChunk = 256, kRound = 64;
   uint32_t* start = lists.start.data();
   uint32_t* mid = lists.mid.data();
   lists.chunkBuffers.resize(kRound);

@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
-#include <tuple>
 
 #include "core/parallel.hpp"
 
@@ -44,7 +42,7 @@ namespace {
 }
 
 // the bend constraint (Eq. 9) of constraints [begin, end): C_k to C[k], and gradient component c
-// (x, y, z of a, b, c, d) to G[c * stride + k - base]. Plain float locals only: under omp simd a struct or
+// (x, y, z of a, b, c, d) to G[c * stride + k]. Plain float locals only: under omp simd a struct or
 // a local whose address is taken becomes a per-lane array in memory, and the loop does not vectorise.
 // Gradients: the closed forms of Bridson et al. 2003 (a wing moves the angle by 1/height along the
 // normal; the edge vertices take the share that keeps the sum zero and rotations free).
@@ -59,7 +57,7 @@ struct BendSolve {
 
 template <bool Solve>
 void bendKernel(int begin, int end, const int* __restrict I, const float* __restrict rest, const float* __restrict X,
-                float* __restrict Cout, float* __restrict G, int stride, BendSolve solve = {}, int base = 0) {
+                float* __restrict Cout, float* __restrict G, int stride, BendSolve solve = {}) {
   const float* __restrict const compliance = solve.compliance;
   const float* __restrict const w = solve.w;
   float* __restrict const lambda = solve.lambda;
@@ -97,7 +95,7 @@ void bendKernel(int begin, int end, const int* __restrict I, const float* __rest
     C += (C < -kPi ? 2.0f * kPi : 0.0f);
     C = z * C;
     if constexpr (!Solve) {
-      for (int c = 0; c < 12; ++c) G[c * stride + k - base] = g[c];
+      for (int c = 0; c < 12; ++c) G[c * stride + k] = g[c];
       Cout[k] = C;
     } else {
       // XPBD (Macklin et al. 2016, Eq. 17-18), as stretchRange
@@ -114,7 +112,7 @@ void bendKernel(int begin, int end, const int* __restrict I, const float* __rest
       const float dl = denom > 0.0f ? (-C - alpha * lambda[k]) / std::max(denom, 1e-30f) : 0.0f;
       lambda[k] += dl;
       const float f[4] = {w0 * dl, w1 * dl, w2 * dl, w3 * dl};
-      for (int c = 0; c < 12; ++c) G[c * stride + k - base] = g[c] * f[c / 3];
+      for (int c = 0; c < 12; ++c) G[c * stride + k] = g[c] * f[c / 3];
     }
   }
 }
@@ -139,8 +137,7 @@ namespace {
 // XPBD updates of constraints [begin, end) of one colour (Macklin et al. 2016, Eq. 17-18):
 // dlambda = (-C - alpha~ lambda) / (sum_k w_k |grad_k C|^2 + alpha~), x_k += w_k grad_k dlambda.
 // A colour's constraints share no particle: their moves are computed in a vectorised loop (gathers)
-// into out (component c of constraint k at out[c * stride + k - begin]: a block's own buffer), then
-// added by the caller (scatters).
+// into out (component c of constraint k at out[c * stride + k]), then added by the caller (scatters).
 void stretchRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
                   const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
                   float* __restrict lambda, float* __restrict out, size_t stride) {
@@ -158,20 +155,19 @@ void stretchRange(int begin, int end, const int* __restrict I, const float* __re
     const float dl = denom > 0.0f ? (-C - alpha * lambda[k]) / std::max(denom, 1e-30f) : 0.0f;
     lambda[k] += dl;
     const float fa = w[a] * dl, fb = -w[b] * dl;
-    const int at = k - begin;
-    out[at] = fa * gx;
-    out[stride + at] = fa * gy;
-    out[2 * stride + at] = fa * gz;
-    out[3 * stride + at] = fb * gx;
-    out[4 * stride + at] = fb * gy;
-    out[5 * stride + at] = fb * gz;
+    out[k] = fa * gx;
+    out[stride + k] = fa * gy;
+    out[2 * stride + k] = fa * gz;
+    out[3 * stride + k] = fb * gx;
+    out[4 * stride + k] = fb * gy;
+    out[5 * stride + k] = fb * gz;
   }
 }
 
 void bendRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
                const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
                float* __restrict lambda, float* __restrict out, size_t strideSize) {
-  bendKernel<true>(begin, end, I, rest, X, nullptr, out, static_cast<int>(strideSize), {compliance, invDt2, w, lambda}, begin);
+  bendKernel<true>(begin, end, I, rest, X, nullptr, out, static_cast<int>(strideSize), {compliance, invDt2, w, lambda});
 }
 
 }  // namespace
@@ -186,6 +182,8 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   const BendConstraints& bd = model.bend;
   scratch.stretchLambda.assign(st.ids.size(), 0.0f);
   scratch.bendLambda.assign(bd.ids.size(), 0.0f);
+  scratch.correction.resize(6 * st.ids.size());
+  scratch.correctionBend.resize(12 * bd.ids.size());
   if (model.numCloth == 0 || dt <= 0.0f) return;
   const float invDt2 = 1.0f / (dt * dt);
   Vec3* x = p.xPred.data();
@@ -193,46 +191,35 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   float* stretchLambda = scratch.stretchLambda.data();
   float* bendLambda = scratch.bendLambda.data();
 
-  // each thread's moves of at most kPiece constraints at a time (18 KiB, in L1): buffers the size of
-  // all constraints were written and read again every iteration from farther caches
-  constexpr int kPiece = 256;
-  scratch.correction.resize(static_cast<size_t>(threadCount()) * 6 * kPiece);
-  scratch.correctionBend.resize(static_cast<size_t>(threadCount()) * 12 * kPiece);
-  // constraints [begin, end) of one colour (vertices ids[k]), kPiece at a time: range(b0, b1) writes
-  // their moves to corr (three rows a vertex, kPiece apart), which are then added to the vertices
-  const auto inPieces = [&](int begin, int end, float* corr, const auto& ids, auto&& range) {
-    constexpr int nv = static_cast<int>(std::tuple_size_v<typename std::decay_t<decltype(ids)>::value_type>);
-    for (int b0 = begin; b0 < end; b0 += kPiece) {
-      const int b1 = std::min(end, b0 + kPiece);
-      range(b0, b1);
-      for (int k = b0; k < b1; ++k)
-        for (int v = 0; v < nv; ++v)
-          x[ids[k][v]] += Vec3(corr[(3 * v) * kPiece + k - b0], corr[(3 * v + 1) * kPiece + k - b0],
-                               corr[(3 * v + 2) * kPiece + k - b0]);
-    }
+  // separate buffers for the two kinds: a thread may project stretch constraints while another
+  // projects bend constraints of the same indices
+  float* corrStretch = scratch.correction.data();
+  float* corrBend = scratch.correctionBend.data();
+  const size_t strideStretch = st.ids.size(), strideBend = bd.ids.size();
+  const auto stretchBlock = [&](int begin, int end) {
+    stretchRange(begin, end, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
+                 stretchLambda, corrStretch, strideStretch);
+    for (int k = begin; k < end; ++k)
+      for (int v = 0; v < 2; ++v)
+        x[st.ids[k][v]] += Vec3(corrStretch[(3 * v) * strideStretch + k], corrStretch[(3 * v + 1) * strideStretch + k],
+                                corrStretch[(3 * v + 2) * strideStretch + k]);
   };
-  const auto stretchBlock = [&](int begin, int end, float* corr) {
-    inPieces(begin, end, corr, st.ids, [&](int b0, int b1) {
-      stretchRange(b0, b1, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
-                   stretchLambda, corr, kPiece);
-    });
-  };
-  const auto bendBlock = [&](int begin, int end, float* corr) {
-    inPieces(begin, end, corr, bd.ids, [&](int b0, int b1) {
-      bendRange(b0, b1, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
-                bendLambda, corr, kPiece);
-    });
+  const auto bendBlock = [&](int begin, int end) {
+    bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
+              bendLambda, corrBend, strideBend);
+    for (int k = begin; k < end; ++k)
+      for (int v = 0; v < 4; ++v)
+        x[bd.ids[k][v]] += Vec3(corrBend[(3 * v) * strideBend + k], corrBend[(3 * v + 1) * strideBend + k],
+                                corrBend[(3 * v + 2) * strideBend + k]);
   };
   // one group: its stretch constraints colour by colour, then its bend constraints
   const ConstraintSchedule& ss = st.schedule;
   const ConstraintSchedule& bs = bd.schedule;
-  const auto solveGroup = [&](int g, int thread) {
-    float* corrStretch = scratch.correction.data() + static_cast<size_t>(thread) * 6 * kPiece;
-    float* corrBend = scratch.correctionBend.data() + static_cast<size_t>(thread) * 12 * kPiece;
+  const auto solveGroup = [&](int g) {
     if (static_cast<size_t>(g) + 1 < ss.groupBlock.size())
-      for (int b = ss.groupBlock[g]; b < ss.groupBlock[g + 1]; ++b) stretchBlock(ss.blockStart[b], ss.blockStart[b + 1], corrStretch);
+      for (int b = ss.groupBlock[g]; b < ss.groupBlock[g + 1]; ++b) stretchBlock(ss.blockStart[b], ss.blockStart[b + 1]);
     if (static_cast<size_t>(g) + 1 < bs.groupBlock.size())
-      for (int b = bs.groupBlock[g]; b < bs.groupBlock[g + 1]; ++b) bendBlock(bs.blockStart[b], bs.blockStart[b + 1], corrBend);
+      for (int b = bs.groupBlock[g]; b < bs.groupBlock[g + 1]; ++b) bendBlock(bs.blockStart[b], bs.blockStart[b + 1]);
   };
   // Gauss-Seidel in a fixed order of phases: every slab (in parallel, a slab's groups whole on one
   // thread), the interfaces between slabs k and k + 1 for even k, then for odd k, then the rest on
@@ -244,14 +231,14 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     for (int it = 0; it < iterations; ++it) {
-      for (int g = slabs * t / nt; g < slabs * (t + 1) / nt; ++g) solveGroup(g, t);
+      for (int g = slabs * t / nt; g < slabs * (t + 1) / nt; ++g) solveGroup(g);
 #pragma omp barrier
       for (int parity = 0; parity < 2; ++parity) {
-        for (int m = interfaces[parity] * t / nt; m < interfaces[parity] * (t + 1) / nt; ++m) solveGroup(slabs + 2 * m + parity, t);
+        for (int m = interfaces[parity] * t / nt; m < interfaces[parity] * (t + 1) / nt; ++m) solveGroup(slabs + 2 * m + parity);
 #pragma omp barrier
       }
 #pragma omp single
-      solveGroup(2 * slabs - 1, t);
+      solveGroup(2 * slabs - 1);
     }
   }
 }

@@ -38,7 +38,7 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
 // scratch for the cloth solver (XPBD multipliers)
 struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
-  std::vector<float> correction;      // m, per thread: the moves of up to 256 stretch constraints' particles, 6 per constraint (SoA)
+  std::vector<float> correction;      // m, the moves of the stretch constraints' particles, 6 per constraint (SoA)
   std::vector<float> correctionBend;  // m, the same for the bend constraints, 12 per constraint
   std::vector<Vec3> delta;
   std::vector<int> deltaCount;
