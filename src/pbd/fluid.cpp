@@ -521,8 +521,8 @@ inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1,
 
 }  // namespace
 
-// water particles a chunk of the solver's dynamically scheduled passes: against static halves -2 to
-// -8 % (Figs. 5(c), 9(b)); chunks of 256 were slower than static halves
+// water particles a chunk of the solver's dynamically scheduled passes: against static halves a few
+// per cent faster (Figs. 5(c), 9(b), docs/performance.md session 12); chunks of 256 were slower
 constexpr int64_t kWaterPassChunk = 1024;
 
 // The solver's neighbour loops are densitySums, correctionSum and reactionSum above (AVX-512 by hand
