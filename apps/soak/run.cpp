@@ -250,9 +250,9 @@ int runCommand(const RunOptions& o) {
       // Table 2 of Shao 2017 gives the wetting's time apart from the step's: the same split, stage by stage
       const double steps = static_cast<double>(state.stepCount);
       std::string parts;
-      for (int k = 0; k < kStagePartCount; ++k) {
-        const std::string name = kStagePartNames[k];
-        if (name.rfind("wetting.", 0) == 0) parts += fmt::format("{}{} {:.2f}", parts.empty() ? "" : ", ", name.substr(8), runMs.parts[k] / steps);
+      for (int k = static_cast<int>(StagePart::wettingPorosity); k <= static_cast<int>(StagePart::wettingFinish); ++k) {
+        const std::string name = kStagePartNames[k];  // "wetting.porosity": the stage's name after the dot
+        parts += fmt::format("{}{} {:.2f}", parts.empty() ? "" : ", ", name.substr(name.find('.') + 1), runMs.parts[k] / steps);
       }
       std::printf("soak: solver %.2f ms a step (frames not written), of which wetting %.2f (%s)\n", runMs.total / steps,
                   runMs.wetting / steps, parts.c_str());

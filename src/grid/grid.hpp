@@ -53,14 +53,17 @@ struct NeighborGrid {
     return nRanges;
   }
 
-  // calls f(j) once for every particle j in the 27 cells around p (a superset of those within
-  // cellSize of p), in a fixed order; buckets shared by two cells are visited once
+  // calls f(j) for the particles j in the 27 cells around p (a superset of those within cellSize of
+  // p), each once, in a fixed order (buckets shared by two cells are visited once), until f returns
+  // true; returns whether it did
   template <class F>
-  void forEachCandidate(const Vec3& p, F&& f) const {
+  bool forEachCandidate(const Vec3& p, F&& f) const {
     uint32_t ranges[27][2];
     const int nr = candidateRanges(cellOf(p), ranges);
     for (int r = 0; r < nr; ++r)
-      for (uint32_t k = ranges[r][0]; k < ranges[r][1]; ++k) f(cellEntries[k]);
+      for (uint32_t k = ranges[r][0]; k < ranges[r][1]; ++k)
+        if (f(cellEntries[k])) return true;
+    return false;
   }
 };
 

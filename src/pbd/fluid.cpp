@@ -183,8 +183,8 @@ struct PairInputs {
 // With AVX-512, the pair sums below take 16 neighbours at a time: j's data are gathered (positions
 // loaded and transposed), every lane does the scalar loop's arithmetic for its pair (same operations,
 // same order, no FMA), and the sums are kept per lane and added across lanes at the end. Lanes past
-// the list's end have mass 0 and masked kernels: they add 0. Lists shorter than kSimdMinPairs (spray) take the scalar loop,
-// which is then faster. The order of the sums depends on the list's length, never on the thread
+// the list's end have mass 0 and masked kernels: they add 0. Lists shorter than kSimdMinPairs (spray)
+// take the scalar loop, which is then faster. The order of the sums depends on the list's length, never on the thread
 // count; results differ from a build without AVX-512 in the last bits. Hand-written: GCC 12
 // vectorised these loops with scalar loads in place of gathers, slower than scalar (docs/performance.md).
 constexpr uint32_t kSimdMinPairs = 4;

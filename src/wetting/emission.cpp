@@ -45,12 +45,6 @@ Vec3 vertexNormal(const Model& model, const std::vector<Vec3>& x, int64_t i) {
   return len > 1e-20f ? Vec3(n / len) : Vec3::Zero();
 }
 
-// SPH density a drip of mass m and radius hp would have at y, without the drips made in this stage
-// (indices from gridSize on): itself, the water and the cloth as Akinci boundary particles (Psi_b =
-// rho0 V_b). big: the particles wider than the grid's cells (NeighborLists::big), which its 27 cells
-// may not reach. Stops once the sum passes limit and returns that partial sum: every term is >= 0
-// and adding one never lowers a float sum, so the whole sum would be above limit too (a drip source
-// under water tried its 30 places against every particle around each: 3.6 of Fig. 9(b)'s 7 ms)
 // W(y - x_j) of a drip of radius hp at y and particle j, over the pair's mean radius; 0 outside it
 float dripKernel(const Particles& p, const Vec3& y, float hp, size_t j) {
   const float hij = pairRadius(hp, p.radius[j]);
@@ -58,28 +52,29 @@ float dripKernel(const Particles& p, const Vec3& y, float hp, size_t j) {
   return r2 < hij * hij ? poly6(r2, hij) : 0.0f;
 }
 
+// SPH density a drip of mass m and radius hp would have at y, without the drips made in this stage
+// (indices from gridSize on): itself, the water and the cloth as Akinci boundary particles (Psi_b =
+// rho0 V_b). big: the particles wider than the grid's cells (NeighborLists::big), which its 27 cells
+// may not reach. Stops once the sum passes limit and returns that partial sum: every term is >= 0
+// and adding one never lowers a float sum, so the whole sum would be above limit too (a drip source
+// under water tried its 30 places against every particle around each: 3.6 of Fig. 9(b)'s 7 ms)
 float dripDensityBefore(const Model& model, const Particles& p, const NeighborGrid& grid, const std::vector<uint32_t>& big,
                         const WettingScratch& s, const Vec3& y, float m, float hp, float limit) {
   const int64_t nc = model.numCloth;
   const float rho0 = model.water.restDensity;
   float rho = m * poly6(0.0f, hp);
+  // adds particle j's term; true once the sum has passed limit
   const auto add = [&](size_t j) {
     const float w = dripKernel(p, y, hp, j);
     if (w > 0.0f) rho += (static_cast<int64_t>(j) < nc ? rho0 * s.volume[j] : p.mass[j]) * w;
+    return rho > limit;
   };
-  uint32_t ranges[27][2];  // forEachCandidate's order
-  const int nr = grid.candidateRanges(grid.cellOf(y), ranges);
-  for (int r = 0; r < nr; ++r)
-    for (uint32_t k = ranges[r][0]; k < ranges[r][1]; ++k) {
-      const uint32_t j = grid.cellEntries[k];
-      if (std::binary_search(big.begin(), big.end(), j)) continue;  // each big one once, below
-      add(j);
-      if (rho > limit) return rho;
-    }
-  for (const uint32_t j : big) {
-    add(j);
-    if (rho > limit) return rho;
-  }
+  const bool over = grid.forEachCandidate(y, [&](uint32_t j) {
+    return !std::binary_search(big.begin(), big.end(), j) && add(j);  // each big one once, below
+  });
+  if (!over)
+    for (const uint32_t j : big)
+      if (add(j)) break;
   return rho;
 }
 
