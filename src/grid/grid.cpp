@@ -275,7 +275,9 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   // the neighbours of i among the candidates of ranges [ranges[2r], ranges[2r + 1]) of the entries,
   // cloth ones to cl[nCloth ..) and water ones to wa[nWater ..), in candidate order. Candidates with
   // a radius above `cutoff` are skipped. Branch free: every candidate is written, the cursor advances
-  // only for neighbours.
+  // only for neighbours (AVX-512: all of them to wa first, one store a vector, and the cloth ones
+  // moved to cl afterwards when there are any: 8 % off the list build of Fig. 5(c), docs/performance.md
+  // session 13)
   const auto scan = [&](size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
                         std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) {
     const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
@@ -287,20 +289,19 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
     const float* const PZ = pz;
     const float* const PH = ph;
     const uint32_t* const E = entries;
+#if defined(__AVX512F__)
+    // every neighbour to wa in candidate order, then the cloth ones (if any) moved to cl, both kept in
+    // candidate order: the lists are the scalar loop's
+    __mmask16 anyCloth = 0;
+    const uint32_t nwa0 = nwa;
     for (int r = 0; r < count; ++r) {
       const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
-      if (ncl + (k1 - k0) + 16 > cl.size()) cl.resize(2 * (ncl + (k1 - k0) + 16));  // + 16: whole-vector stores
-      if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));
-      uint32_t* pc = cl.data();
+      if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));  // + 16: whole-vector stores
       uint32_t* pw = wa.data();
-      uint32_t k = k0;
-#if defined(__AVX512F__)
-      // 16 candidates at a time; the neighbours are compressed into the lists in candidate order,
-      // so the lists are the same as the scalar loop's
       const __m512 vx = _mm512_set1_ps(xi), vy = _mm512_set1_ps(yi), vz = _mm512_set1_ps(zi);
       const __m512 vh = _mm512_set1_ps(hi), half = _mm512_set1_ps(0.5f), vcut = _mm512_set1_ps(cutoff);
       const __m512i self = _mm512_set1_epi32(static_cast<int>(i)), split = _mm512_set1_epi32(static_cast<int>(firstWater));
-      for (; k < k1; k += 16) {
+      for (uint32_t k = k0; k < k1; k += 16) {
         const __mmask16 lanes = k1 - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (k1 - k)) - 1u);
         const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, PX + k));
         const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, PY + k));
@@ -312,17 +313,33 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
         const __m512i j = _mm512_maskz_loadu_epi32(lanes, E + k);
         const __mmask16 in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(h, h), _CMP_LT_OQ) &
                              _mm512_cmp_ps_mask(hj, vcut, _CMP_LE_OQ) & _mm512_cmpneq_epi32_mask(j, self);
-        const __mmask16 isCloth = _mm512_cmplt_epu32_mask(j, split);
-        const __mmask16 inCloth = in & isCloth, inWater = in & static_cast<__mmask16>(~isCloth);
-        // compress in a register and store all 16 lanes (the lists have room): a compressing store
+        anyCloth |= in & _mm512_cmplt_epu32_mask(j, split);
+        // compress in a register and store all 16 lanes (the list has room): a compressing store
         // to memory is microcoded and slow on AMD Zen 4
-        _mm512_storeu_si512(pc + ncl, _mm512_maskz_compress_epi32(inCloth, j));
-        _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(inWater, j));
-        ncl += static_cast<uint32_t>(__builtin_popcount(inCloth));
-        nwa += static_cast<uint32_t>(__builtin_popcount(inWater));
+        _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(in, j));
+        nwa += static_cast<uint32_t>(__builtin_popcount(in));
       }
+    }
+    if (anyCloth) {
+      if (ncl + (nwa - nwa0) > cl.size()) cl.resize(2 * (ncl + (nwa - nwa0)));
+      uint32_t keep = nwa0;
+      for (uint32_t e = nwa0; e < nwa; ++e) {
+        const uint32_t j = wa[e];
+        if (j < firstWater)
+          cl[ncl++] = j;
+        else
+          wa[keep++] = j;
+      }
+      nwa = keep;
+    }
 #else
-      for (; k < k1; ++k) {
+    for (int r = 0; r < count; ++r) {
+      const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
+      if (ncl + (k1 - k0) > cl.size()) cl.resize(2 * (ncl + (k1 - k0)));
+      if (nwa + (k1 - k0) > wa.size()) wa.resize(2 * (nwa + (k1 - k0)));
+      uint32_t* pc = cl.data();
+      uint32_t* pw = wa.data();
+      for (uint32_t k = k0; k < k1; ++k) {
         const float dx = xi - PX[k], dy = yi - PY[k], dz = zi - PZ[k];
         const float h = 0.5f * (hi + PH[k]);
         const uint32_t j = E[k];
@@ -333,8 +350,8 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
         ncl += in & isCloth;
         nwa += in & (isCloth ^ 1u);
       }
-#endif
     }
+#endif
     nCloth = ncl;
     nWater = nwa;
   };
