@@ -232,6 +232,7 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
                         NeighborLists& lists, uint32_t firstWater) {
   const size_t n = x.size();
   lists.firstWater = firstWater;
+  ++lists.generation;
   lists.start.resize(n + 1);
   lists.mid.resize(n);
   lists.start[0] = 0;

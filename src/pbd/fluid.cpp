@@ -561,6 +561,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   // mixed radii: the particles whose pairs all have h0 still take the constant-radius loops
   if (!uniform) hU = wp.supportRadius;
   markNeighbourhoods(p, nb, nc, wp.particleMass, hU, uniform ? nullptr : &s.mixedRadius, &s.plain);
+  s.mixedGeneration = uniform ? 0 : nb.generation;  // the velocity pass of the same lists takes these flags
   const uint8_t* const mixed = s.mixedRadius.data();
   const uint8_t* const plain = s.plain.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
@@ -661,7 +662,11 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   float hU = 0.0f;
   const bool uniform = commonRadius(p.radius, hU);
   // as in solveFluid: only the particles with a pair of another radius take the per-pair radius
-  if (!uniform) hU = wp.supportRadius, markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
+  // (the radii have not changed since solveFluid marked these lists: the wetting stages come after)
+  if (!uniform) {
+    hU = wp.supportRadius;
+    if (s.mixedGeneration != nb.generation) markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
+  }
   const uint8_t* const mixed = s.mixedRadius.data();
   const float invU = 1.0f / hU;
   // one water particle's XSPH velocity (and vorticity)

@@ -253,15 +253,17 @@ TEST(Fluid, SolverPassMatchesPairByPairReference) {
 TEST(Fluid, XsphMatchesPairByPairReference) {
   // the XSPH pass against a double-precision pair loop of Macklin 2013 Eq. 17 with soak's volume
   // weights 2 m_j / (rho_i + rho_j), equal radii, every other one shrunk, and one shrunk (its
-  // neighbours take the per-pair radius, the others the constant one); scalar: 16-lane gathers were slower
-  for (const int mixed : {0, 1, 2}) {
+  // neighbours take the per-pair radius, the others the constant one); scalar: 16-lane gathers were slower.
+  // Case 3: the solver marked lists where one particle was shrunk, then another one is shrunk instead and
+  // the lists are built again: the velocity pass must mark them again, not take the solver's flags
+  for (const int mixed : {0, 1, 2, 3}) {
     Scene scene = squeezedWaterOnCloth("0");
     const Model& model = scene.model;
     Particles& p = scene.state.particles;
     const size_t nc = static_cast<size_t>(model.numCloth);
     for (size_t i = nc; i < p.size(); ++i) {
       p.v[i] = Vec3(std::sin(0.7f * float(i)), std::cos(1.3f * float(i)), std::sin(2.1f * float(i) + 1.0f));
-      if ((mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2)) p.radius[i] *= 0.8f;
+      if ((mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2) || (mixed == 3 && i == nc)) p.radius[i] *= 0.8f;
     }
     NeighborGrid grid;
     NeighborLists nb;
@@ -270,6 +272,12 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
     FluidScratch s;
     computeBoundaryPsi(model, p, nb, s);
     solveFluid(model, {}, p, nb, s, 1);  // the densities the pass reads
+    if (mixed == 3) {
+      p.radius[nc] = p.radius[nc + 1];
+      p.radius[p.size() - 1] *= 0.8f;
+      buildGrid(p.xPred, maxSupportRadius(p), grid);
+      buildNeighborLists(p.xPred, p.radius, grid, nb, static_cast<uint32_t>(nc));
+    }
     const std::vector<Vec3> v0 = p.v;
     fluidVelocityPass(model, p, nb, s, 0.015f);
     float worst = 0.0f, largest = 0.0f;
@@ -286,7 +294,7 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
       worst = std::max(worst, (p.v[i] - v0[i] - dv).norm());
     }
     EXPECT_GT(largest, 1e-3f);  // the velocities really differ between neighbours
-    EXPECT_LT(worst, 1e-4f * largest) << (mixed == 0 ? "equal radii" : mixed == 1 ? "mixed radii" : "one shrunk");
+    EXPECT_LT(worst, 1e-4f * largest) << (mixed == 0 ? "equal radii" : mixed == 1 ? "mixed radii" : mixed == 2 ? "one shrunk" : "lists built again");
   }
 }
 
