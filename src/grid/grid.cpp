@@ -277,8 +277,8 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   // cloth ones to cl[nCloth ..) and water ones to wa[nWater ..), in candidate order. Candidates with
   // a radius above `cutoff` are skipped. Branch free: every candidate is written, the cursor advances
   // only for neighbours (AVX-512: all of them to wa first, one store a vector, and the cloth ones
-  // moved to cl afterwards when there are any: 8 % off the list build of Fig. 5(c), docs/performance.md
-  // session 13)
+  // moved to cl afterwards when there are any: 4 - 5 % off the list build of Fig. 5(c), 14 % of Fig.
+  // 9(b)'s under water, docs/performance.md session 13)
   const auto scan = [&](size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
                         std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) {
     const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];

@@ -263,7 +263,8 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
     const size_t nc = static_cast<size_t>(model.numCloth);
     for (size_t i = nc; i < p.size(); ++i) {
       p.v[i] = Vec3(std::sin(0.7f * float(i)), std::cos(1.3f * float(i)), std::sin(2.1f * float(i) + 1.0f));
-      if ((mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2) || (mixed == 3 && i == nc)) p.radius[i] *= 0.8f;
+      const bool shrink = (mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2) || (mixed == 3 && i == nc);
+      if (shrink) p.radius[i] *= 0.8f;
     }
     NeighborGrid grid;
     NeighborLists nb;
@@ -294,7 +295,8 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
       worst = std::max(worst, (p.v[i] - v0[i] - dv).norm());
     }
     EXPECT_GT(largest, 1e-3f);  // the velocities really differ between neighbours
-    EXPECT_LT(worst, 1e-4f * largest) << (mixed == 0 ? "equal radii" : mixed == 1 ? "mixed radii" : mixed == 2 ? "one shrunk" : "lists built again");
+    const char* what[] = {"equal radii", "mixed radii", "one shrunk", "lists built again"};
+    EXPECT_LT(worst, 1e-4f * largest) << what[mixed];
   }
 }
 
