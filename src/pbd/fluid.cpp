@@ -184,8 +184,8 @@ struct PairInputs {
 // loaded and transposed), every lane does the scalar loop's arithmetic for its pair (same operations,
 // same order, no FMA), and the sums are kept per lane and added across lanes at the end. Lanes past
 // the list's end have mass 0 and masked kernels: they add 0. Lists shorter than kSimdMinPairs (spray)
-// take the scalar loop, which is then faster. The order of the sums depends on the list's length, never on the thread
-// count; results differ from a build without AVX-512 in the last bits. Hand-written: GCC 12
+// take the scalar loop, which is then faster. The order of the sums depends on the list's length,
+// never on the thread count; results differ from a build without AVX-512 in the last bits. Hand-written: GCC 12
 // vectorised these loops with scalar loads in place of gathers, slower than scalar (docs/performance.md).
 constexpr uint32_t kSimdMinPairs = 4;
 namespace v16 {
@@ -665,7 +665,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   // (the radii have not changed since solveFluid marked these lists: the wetting stages come after)
   if (!uniform) {
     hU = wp.supportRadius;
-    if (s.mixedGeneration != nb.generation) markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
+    if (nb.generation == 0 || s.mixedGeneration != nb.generation) markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
   }
   const uint8_t* const mixed = s.mixedRadius.data();
   const float invU = 1.0f / hU;

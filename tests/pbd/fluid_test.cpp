@@ -254,16 +254,17 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
   // the XSPH pass against a double-precision pair loop of Macklin 2013 Eq. 17 with soak's volume
   // weights 2 m_j / (rho_i + rho_j), equal radii, every other one shrunk, and one shrunk (its
   // neighbours take the per-pair radius, the others the constant one); scalar: 16-lane gathers were slower.
-  // Case 3: the solver marked lists where one particle was shrunk, then another one is shrunk instead and
-  // the lists are built again: the velocity pass must mark them again, not take the solver's flags
-  for (const int mixed : {0, 1, 2, 3}) {
+  // Cases 3 and 4: the solver marked lists where one particle was shrunk, then another one is shrunk
+  // instead and the lists are built again (3: in the same object, 4: in a fresh one): the velocity pass
+  // must mark them again, not take the solver's flags
+  for (const int mixed : {0, 1, 2, 3, 4}) {
     Scene scene = squeezedWaterOnCloth("0");
     const Model& model = scene.model;
     Particles& p = scene.state.particles;
     const size_t nc = static_cast<size_t>(model.numCloth);
     for (size_t i = nc; i < p.size(); ++i) {
       p.v[i] = Vec3(std::sin(0.7f * float(i)), std::cos(1.3f * float(i)), std::sin(2.1f * float(i) + 1.0f));
-      const bool shrink = (mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2) || (mixed == 3 && i == nc);
+      const bool shrink = (mixed == 1 && i % 2 == 0) || (mixed == 2 && i == nc + (p.size() - nc) / 2) || (mixed >= 3 && i == nc);
       if (shrink) p.radius[i] *= 0.8f;
     }
     NeighborGrid grid;
@@ -273,19 +274,21 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
     FluidScratch s;
     computeBoundaryPsi(model, p, nb, s);
     solveFluid(model, {}, p, nb, s, 1);  // the densities the pass reads
-    if (mixed == 3) {
+    NeighborLists fresh;
+    NeighborLists& lists = mixed == 4 ? fresh : nb;
+    if (mixed >= 3) {
       p.radius[nc] = p.radius[nc + 1];
       p.radius[p.size() - 1] *= 0.8f;
       buildGrid(p.xPred, maxSupportRadius(p), grid);
-      buildNeighborLists(p.xPred, p.radius, grid, nb, static_cast<uint32_t>(nc));
+      buildNeighborLists(p.xPred, p.radius, grid, lists, static_cast<uint32_t>(nc));
     }
     const std::vector<Vec3> v0 = p.v;
-    fluidVelocityPass(model, p, nb, s, 0.015f);
+    fluidVelocityPass(model, p, lists, s, 0.015f);
     float worst = 0.0f, largest = 0.0f;
     for (size_t i = nc; i < p.size(); ++i) {
       Eigen::Vector3d b = Eigen::Vector3d::Zero();
-      for (uint32_t k = nb.waterBegin(i, static_cast<uint32_t>(nc)); k < nb.start[i + 1]; ++k) {
-        const uint32_t j = nb.index[k];
+      for (uint32_t k = lists.waterBegin(i, static_cast<uint32_t>(nc)); k < lists.start[i + 1]; ++k) {
+        const uint32_t j = lists.index[k];
         const double vol = 2.0 * p.mass[j] / std::max(double(s.density[i]) + s.density[j], 1e-3);
         const double w = poly6((p.xPred[i] - p.xPred[j]).squaredNorm(), pairRadius(p.radius[i], p.radius[j]));
         b += vol * w * (v0[j] - v0[i]).cast<double>();
@@ -295,7 +298,7 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
       worst = std::max(worst, (p.v[i] - v0[i] - dv).norm());
     }
     EXPECT_GT(largest, 1e-3f);  // the velocities really differ between neighbours
-    const char* what[] = {"equal radii", "mixed radii", "one shrunk", "lists built again"};
+    const char* what[] = {"equal radii", "mixed radii", "one shrunk", "lists built again", "lists built in a fresh object"};
     EXPECT_LT(worst, 1e-4f * largest) << what[mixed];
   }
 }
