@@ -243,6 +243,9 @@ float contactMargin(const Model& model, int32_t phase) {
 //   dx = (x* - x) - v_col(x*) dt                                   (slip relative to the collider)
 //   x* <- x* - mu (dx - (dx.n) n)                                  (remove the fraction mu of the
 //                                                                  tangential slip)
+// A thin wall crossed past its middle in one substep is nearest its far face: a particle that started
+// clear of the collider on the opposite face and moved along the nearest face's normal is instead put
+// on the plane of the face it came in by (docs/models.md, "Colliders").
 // mu = collider.friction for water, 0.5 (collider.friction + cloth material friction) for cloth.
 // mu = 1 makes the particle move tangentially with the collider surface, mu = 0 lets it slide.
 void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
@@ -271,8 +274,19 @@ void projectColliders(const Model& model, const std::vector<ColliderPose>& poses
     for (size_t c = 0; c < numColliders; ++c) {
       const Collider& col = model.colliders[c];
       Vec3 nrm;
-      const float d = colliderDistance(col, poses[c], xp, &nrm) - margin;
+      float d = colliderDistance(col, poses[c], xp, &nrm) - margin;
       if (d >= 0.0f) continue;
+      // a thin wall crossed past its middle in one substep is nearest its far face: back through the face it came in by
+      const Vec3 from = p.x[i] + poses[c].velocityAt(p.x[i]) * dt;  // the start, carried with the collider
+      if ((xp - from).dot(nrm) > 0.0f) {
+        Vec3 n0;
+        const float s0 = colliderDistance(col, poses[c], from, &n0);
+        if (s0 >= 0.0f && n0.dot(nrm) < 0.0f) {
+          d = (xp - from).dot(n0) + s0 - margin;  // xp's distance to the entry face's plane, less the margin
+          if (d >= 0.0f) continue;
+          nrm = n0;
+        }
+      }
       xp -= d * nrm;
       const Vec3 dx = (xp - p.x[i]) - poses[c].velocityAt(xp) * dt;
       const Vec3 tangential = dx - dx.dot(nrm) * nrm;

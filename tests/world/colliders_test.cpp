@@ -404,6 +404,42 @@ TEST(ColliderContact, SpherePushesOutRadially) {
   expectVec(normals[0], dir, 1e-6f);
 }
 
+// a container wall crossed past its middle within one substep is nearer its far face: the particle
+// goes back out through the face it came in by, from inside the container and from outside alike
+TEST(ColliderContact, ThinWallCrossedPastItsMiddleSendsTheParticleBack) {
+  Model m = planeModel(0.0f);
+  m.colliders[0] = makeCollider(ColliderShape::Container);
+  m.colliders[0].halfExtents = Vec3(0.5f, 0.25f, 0.5f);
+  m.colliders[0].wallThickness = 0.04f;  // the +x wall spans x = 0.50 .. 0.54, its middle 0.52
+  m.colliders[0].friction = 0.0f;
+  const float margin = contactMargin(m, kWaterPhase);
+  Particles p;
+  p.add(kWaterPhase, 0, 0.008f, 0.04f, Vec3(0.49f, 0.0f, 0.1f), Vec3::Zero());  // inside, 0.01 from the wall
+  p.add(kWaterPhase, 1, 0.008f, 0.04f, Vec3(0.56f, 0.0f, 0.1f), Vec3::Zero());  // outside
+  p.add(kWaterPhase, 2, 0.008f, 0.04f, Vec3(0.49f, 0.0f, -0.1f), Vec3::Zero());  // inside, not past the middle
+  p.xPred[0] = Vec3(0.525f, 0.0f, 0.1f);
+  p.xPred[1] = Vec3(0.515f, 0.0f, 0.1f);
+  p.xPred[2] = Vec3(0.515f, 0.0f, -0.1f);
+  std::vector<Vec3> normals;
+  projectColliders(m, posesAt(m, 0.0), p, 0.015f, normals);
+  expectVec(p.xPred[0], Vec3(0.5f - margin, 0.0f, 0.1f), 1e-6f);
+  expectVec(normals[0], Vec3(-1, 0, 0), 0.0f);
+  expectVec(p.xPred[1], Vec3(0.54f + margin, 0.0f, 0.1f), 1e-6f);
+  expectVec(normals[1], Vec3(1, 0, 0), 0.0f);
+  expectVec(p.xPred[2], Vec3(0.5f - margin, 0.0f, -0.1f), 1e-6f);
+  // a particle driven at the wall at 2 m/s, a 0.03 m substep: it stays in the container
+  Particles q;
+  q.add(kWaterPhase, 0, 0.008f, 0.04f, Vec3(0.40f, 0.0f, 0.0f), Vec3(2.0f, 0.0f, 0.0f));
+  const float dt = 0.015f;
+  for (int step = 0; step < 10; ++step) {
+    q.v[0] = Vec3(2.0f, 0.0f, 0.0f);
+    q.xPred[0] = q.x[0] + dt * q.v[0];
+    projectColliders(m, posesAt(m, step * dt), q, dt, normals);
+    q.x[0] = q.xPred[0];
+    ASSERT_LE(q.x[0].x(), 0.5f - margin + 1e-6f) << "step " << step;
+  }
+}
+
 // a particle resting on a plane that slides along x is carried with it when friction is 1,
 // stays behind when friction is 0 (integrated like the step: predict, project, v = dx / dt)
 TEST(ColliderContact, MovingColliderDragsParticleWithFriction) {
