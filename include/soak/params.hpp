@@ -72,6 +72,7 @@ struct WettingParams {
   bool emission = true;
   float beta = 1.5f;                 // s^2/m, beta of Eq. 18
   float massThreshold = 0.002f;      // kg, m^threshold: a buffer this full forms a drip
+  float maxDripMass = 0.0f;          // kg, a hanging drip this heavy is let go (0: four water.particleMass)
   float attraction = 10.0f;          // m/s^2, kappa^e of Eq. 19
   float attractionSaturation = 0.01f;  // kg, eta^e of Eq. 19
   // wet dynamics, Eq. 20 and Eq. 22

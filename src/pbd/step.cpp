@@ -84,7 +84,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
     wetLap(StagePart::wettingAbsorption);
     diffuseWater(model, state, ws.neighbors, ws.wetting, wetDt);                    // spreads in the cloth (Eq. 12-17)
     wetLap(StagePart::wettingDiffusion);
-    emitExcessWater(model, state, ws.neighbors, ws.grid, ws.wetting, wetDt);        // excess runs down, drips (Eq. 18)
+    emitExcessWater(model, state, ws.neighbors, ws.grid, ws.poses, ws.wetting, wetDt);  // excess runs down, drips (Eq. 18)
     wetLap(StagePart::wettingEmission);
     applyDripAttraction(model, state, ws.neighbors, ws.wetting, wetDt);             // cloth holds its drips (Eq. 19)
     wetLap(StagePart::wettingAttraction);

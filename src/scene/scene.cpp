@@ -195,6 +195,10 @@ void readWetting(ObjectReader r, WettingParams& w) {
   w.emission = e.boolean("enabled", d.emission);
   w.beta = e.number("beta", d.beta, Range::nonNegative());
   w.massThreshold = e.number("massThreshold", d.massThreshold, Range::positive());
+  w.maxDripMass = e.number("maxDripMass", d.maxDripMass, Range::positive());
+  if (w.maxDripMass > 0.0f && w.maxDripMass < w.massThreshold)
+    log.error(e.pathOf("maxDripMass"), fmt::format("expected a number >= wetting.emission.massThreshold ({}), got {}",
+                                                  w.massThreshold, w.maxDripMass));
   w.attraction = e.number("attraction", d.attraction, Range::nonNegative());
   w.attractionSaturation = e.number("attractionSaturation", d.attractionSaturation, Range::nonNegative());
   e.finish();

@@ -94,10 +94,12 @@ constexpr int kDripTries = 30;
 struct DripDirections {
   Vec3 dirs[5];
   explicit DripDirections(const Vec3& g, const Vec3& n) : dirs{g, (g + n).normalized(), (g - n).normalized(), n, -n} {}
-  // placement t from x_i; false when its direction does not exist (no gravity, a degenerate normal)
+  // placement t from x_i; false when its direction does not exist (no gravity, a degenerate normal) or
+  // points more than 30 degrees above the horizontal: no drip on the top face of a sheet lying flat (on
+  // a ball or a floor, where it was pushed into the sheet and flung), its excess runs down (Eq. 18)
   bool placement(const Vec3& xi, float hp, int t, Vec3& y) const {
     const Vec3& dir = dirs[t / 6];
-    if (!dir.allFinite() || dir.squaredNorm() < 0.5f) return false;
+    if (!dir.allFinite() || dir.squaredNorm() < 0.5f || dir.dot(dirs[0]) < -0.5f) return false;
     y = xi + (0.25f * static_cast<float>(t % 6 + 1) * hp) * dir;
     return true;
   }
@@ -106,7 +108,7 @@ struct DripDirections {
 }  // namespace
 
 size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
-                       WettingScratch& s, float h) {
+                       const std::vector<ColliderPose>& poses, WettingScratch& s, float h) {
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   if (!w.enabled || !w.emission || nc == 0) return 0;
@@ -116,13 +118,16 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const double c = w.c;
 
   // 1. water above S^EW goes into the buffer: EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as
-  // computeSaturation, in the same loop
+  // computeSaturation, in the same loop. A buffer holding m^threshold (a drip that found no place,
+  // under water) takes no more, from its particle or from above (step 3), so a sheet under water does
+  // not pump the pool into its buffers (departure: docs/models.md)
+  const double full = static_cast<double>(w.massThreshold);
   std::vector<float>& sat = state.clothSaturation;
   sat.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
     const double keep = static_cast<double>(w.saturationEmit) * s.volume[i] / c;
     const double excess = state.clothWater[i] - keep;
-    if (excess > 0.0) {
+    if (excess > 0.0 && state.clothBuffer[i] < full) {  // a full buffer takes no more (below)
       state.clothWater[i] = keep;
       state.clothBuffer[i] += excess;
     }
@@ -208,13 +213,15 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       const uint32_t clothL = cloth;
       const int32_t phu = P[u];
       const float vu = volumeAll[u];
-      const double bu = bufferAll[u], rateL = rate;
+      const double* const B = bufferAll;
+      const double bu = bufferAll[u], rateL = rate, fullL = full;
 #pragma omp simd
       for (uint32_t k = 0; k < count; ++k) {
         const uint32_t l = J[k];
         const bool same = (l < clothL) & (P[l] == phu);
+        const uint32_t ll = same ? l : static_cast<uint32_t>(u);  // buffers hold cloth only
         const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
-        const bool below = same & (cosLU > 0.0f);
+        const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL);  // and l's buffer takes water
         const float vw = vu * W[k];
         T[k] = rateL * static_cast<double>(cosLU * vw * (below ? 1.0f : 0.0f)) * bu;  // +-0 where not below
       }
@@ -248,7 +255,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       const uint32_t clothL = cloth;
       const int32_t phk = P[k];
       const float vk = VL[k], osk = OS[k];
-      const double bk = B[k], rateL = rate;
+      const double bk = B[k], rateL = rate, fullL = full;
 #pragma omp simd
       for (uint32_t e = 0; e < count; ++e) {
         const uint32_t j = J[e];
@@ -256,8 +263,8 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
         const uint32_t jj = same ? j : static_cast<uint32_t>(k);
         const float cosKJ = C[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
         const float osj = OS[jj];
-        const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f);  // j sheds into k
-        const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f);    // k sheds into j
+        const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullL);     // j sheds into k
+        const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL);   // k sheds into j
         // outScale_u * rawFlow(u), rawFlow = rate (cos theta_lu V_u W) EW_u
         const double in = static_cast<double>(osj) * (rateL * static_cast<double>(cosKJ * (VL[jj] * W[e])) * B[jj]);
         const double out = static_cast<double>(osk) * (rateL * static_cast<double>(-cosKJ * (vk * W[e])) * bk);
@@ -272,9 +279,11 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   }
   parallelFor(nc, [&](int64_t i) { state.clothBuffer[i] = std::max(0.0, state.clothBuffer[i] + s.delta[i]); });
 
-  // 4. drips, serially in cloth order (few; new ids in a fixed order). Drips that are gone or have
-  // fallen out of their source's reach are let go; a source keeps feeding its hanging drip.
+  // 4. drips, serially in cloth order (few; new ids in a fixed order). Drips that are gone, have
+  // fallen out of their source's reach or have grown to the largest drip mass are let go; a source
+  // keeps feeding its hanging drip up to that mass (departure: docs/models.md)
   const float m0 = model.water.particleMass, h0 = model.water.supportRadius, rho0 = model.water.restDensity;
+  const float maxDrip = std::max(w.maxDripMass > 0.0f ? w.maxDripMass : 4.0f * m0, w.massThreshold);
   std::vector<int64_t>& dripOf = s.dripOf;
   dripOf.assign(static_cast<size_t>(nc), -1);
   size_t kept = 0;
@@ -283,7 +292,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   for (size_t d = 0; d < state.dripId.size(); ++d) {
     const int64_t q = dripIndex[d];
     const int32_t src = state.dripSource[d];
-    if (q < 0 || p.mass[q] <= 0.0f || (p.x[q] - p.x[src]).norm() >= p.radius[q]) continue;
+    if (q < 0 || p.mass[q] <= 0.0f || p.mass[q] >= maxDrip || (p.x[q] - p.x[src]).norm() >= p.radius[q]) continue;
     state.dripId[kept] = state.dripId[d];
     state.dripSource[kept++] = src;
     dripOf[src] = q;
@@ -294,7 +303,8 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     const int64_t q = dripOf[i];
     if (q < 0 || state.clothBuffer[i] <= 0.0) continue;
     const float before = p.mass[q];
-    const float after = before + static_cast<float>(state.clothBuffer[i]);
+    const float after = std::min(before + static_cast<float>(state.clothBuffer[i]), maxDrip);
+    if (!(after > before)) continue;
     state.clothBuffer[i] -= static_cast<double>(after) - static_cast<double>(before);  // exact: both floats
     p.mass[q] = after;
     p.invMass[q] = 1.0f / after;
@@ -308,6 +318,18 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   // add density); then, serially in cloth order, the drips made before it are added, and a placement
   // they crowd moves on to the next ones. The same drips, places and sums as trying every placement
   // serially, with the density's terms added in the same order
+  // a place inside a collider (below a sheet lying on the floor or on a ball) would be pushed out at
+  // the next substep, through the far side of a thin floor or flung off the ball (departure: docs/models.md)
+  const float clearance = contactMargin(model, kWaterPhase);
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  const auto clearOfColliders = [&](const Vec3& y) {
+    for (size_t c = 0; c < numColliders; ++c)
+      if (colliderDistance(model.colliders[c], poses[c], y, nullptr) < clearance) return false;
+    return true;
+  };
+  const auto place = [&](const DripDirections& along, const Vec3& xi, int t, Vec3& y) {
+    return along.placement(xi, hDrip, t, y) && clearOfColliders(y);
+  };
   std::vector<int32_t>& sources = s.dripSources;
   sources.clear();
   for (int64_t i = 0; i < nc; ++i)
@@ -323,7 +345,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     const DripDirections along(g, s.dripNormal[static_cast<size_t>(c)]);
     for (int t = 0; t < kDripTries; ++t) {
       Vec3 y;
-      if (!along.placement(p.x[i], hDrip, t, y)) continue;
+      if (!place(along, p.x[i], t, y)) continue;
       const float rho = dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip, rho0);
       if (rho <= rho0) {
         s.dripTry[static_cast<size_t>(c)] = t;
@@ -340,10 +362,10 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     if (t < 0) continue;  // crowded: try again at the next wetting pass
     const DripDirections along(g, s.dripNormal[static_cast<size_t>(c)]);
     Vec3 y;
-    along.placement(p.x[i], hDrip, t, y);
+    place(along, p.x[i], t, y);
     bool placed = addNewDrips(s.dripBase[static_cast<size_t>(c)], p, gridSize, y, hDrip) <= rho0;
     while (!placed && ++t < kDripTries)
-      if (along.placement(p.x[i], hDrip, t, y))
+      if (place(along, p.x[i], t, y))
         placed = addNewDrips(dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip, rho0), p, gridSize, y, hDrip) <= rho0;
     if (!placed) continue;
     const uint32_t id = state.nextId++;

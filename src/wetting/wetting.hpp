@@ -14,6 +14,7 @@
 #include <soak/state.hpp>
 
 #include "grid/grid.hpp"
+#include "world/colliders.hpp"
 
 #include <cmath>
 #include <string>
@@ -164,9 +165,10 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
 
 // section 4.4: water above S^EW moves into the buffer; buffers pass down to the neighbours below when
 // Eq. 18 holds; a buffer that reaches m^threshold forms a drip below the cloth (placed where its
-// density is not above rest), and feeds the drip hanging from it. Returns the number of drips created.
+// density is not above rest and clear of every collider at `poses` by the water's contact margin), and
+// feeds the drip hanging from it. Returns the number of drips created.
 size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
-                       WettingScratch& s, float h);
+                       const std::vector<ColliderPose>& poses, WettingScratch& s, float h);
 
 // the particle index of each drip of state.dripId, -1 for one that is gone; the water particles may be
 // in any order (they are sorted by cell from time to time), so this does not rely on ids ascending

@@ -43,13 +43,13 @@ TEST(WettingEmission, NoDripBelowTheThresholdOneDripAtIt) {
   ASSERT_NEAR(s.state.particles.x[bottom].y(), 0.9f, 1e-6f);
   s.state.clothBuffer[bottom] = 0.99 * thr;
   const float h = s.model.solver.dt;
-  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, h), 0u);
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, h), 0u);
   EXPECT_EQ(s.state.particles.size(), size_t(s.model.numCloth));
   EXPECT_DOUBLE_EQ(s.state.clothBuffer[bottom], 0.99 * thr);
 
   s.state.clothBuffer[bottom] = 1.25 * thr;
   const double before = accountedWater(s);
-  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, h), 1u);
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, h), 1u);
   const Particles& p = s.state.particles;
   ASSERT_EQ(p.size(), size_t(s.model.numCloth) + 1);
   const size_t q = p.size() - 1;
@@ -69,11 +69,66 @@ TEST(WettingEmission, NoDripBelowTheThresholdOneDripAtIt) {
   EXPECT_GT(p.v[q].y(), 0.0f);
   // the buffer feeds the hanging drip instead of starting a second one
   s.state.clothBuffer[bottom] += 1.0 * thr;
-  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, h), 0u);
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, h), 0u);
   EXPECT_EQ(p.size(), q + 1);
   EXPECT_NEAR(p.mass[q], 2.25f * thr, 1e-7f);
   EXPECT_NEAR(s.state.clothBuffer[bottom], 0.0, 1e-9);
   EXPECT_NEAR(accountedWater(s), before + thr, 1e-9);
+
+  // a drip grows to four water particles' mass at most (a submerged sheet's buffers pile up, and one
+  // drip taking them all made a particle of 0.7 kg in Fig. 9(b)); the rest waits in the buffer
+  const float maxDrip = 4.0f * s.model.water.particleMass;
+  s.state.clothBuffer[bottom] += 100.0 * thr;
+  const double fed = accountedWater(s);
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, h), 0u);
+  EXPECT_FLOAT_EQ(p.mass[q], maxDrip);
+  EXPECT_NEAR(s.state.clothBuffer[bottom], 102.25 * thr - maxDrip, 1e-7);
+  EXPECT_NEAR(accountedWater(s), fed, 1e-12 * fed);
+  // then it is let go (no longer the source's drip, so no longer held by Eq. 19) and a new one starts
+  rig.refresh(s.state, s.model);
+  const uint32_t old = p.id[q];
+  EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, h), 1u);
+  ASSERT_EQ(s.state.dripId.size(), 1u);
+  EXPECT_NE(s.state.dripId[0], old);
+  EXPECT_FLOAT_EQ(s.state.particles.mass[q], maxDrip);
+  EXPECT_NEAR(accountedWater(s), fed, 1e-12 * fed);
+}
+
+// a drip is never placed inside a collider, nor on the top face of a sheet lying flat: under a sheet on
+// the floor the next substep pushed it out through the far side of the thin floor, one inside a ball
+// was flung off it at metres a second, and one on top was pushed into the sheet and flung (Fig. 9(b)).
+// The buffer keeps its water (Eq. 18 runs it down to an edge)
+TEST(WettingEmission, NoDripInsideACollider) {
+  for (const char* collider : {R"({"type": "plane"})", R"({"type": "sphere", "radius": 0.3, "position": [0, -0.3, 0]})"}) {
+    // a horizontal sheet 2 mm above the floor, or lying on the top of the ball
+    Scene s = sceneFromJson(R"({"colliders": [)" + std::string(collider) + R"(], "cloth": [)" +
+                            rectangleJson("s", Vec3(0, 0.002f, 0), 0.2f, 0.2f, 11, 11, "[1, 0, 0]", "[0, 0, 1]", kPinAll) +
+                            R"(], "wetting": {}})");
+    StageRig rig;
+    rig.refresh(s.state, s.model);
+    const std::vector<ColliderPose> poses{colliderPose(s.model.colliders[0], 0.0)};
+    const float thr = s.model.wetting.massThreshold;
+    const size_t mid = 5 * 11 + 5;
+    s.state.clothBuffer[mid] = 1.25 * thr;
+    const double before = accountedWater(s);
+    Scene unaware = s;  // the same without the collider: its first place is below the sheet, in the solid
+    ASSERT_EQ(emitExcessWater(unaware.model, unaware.state, rig.nb, rig.grid, {}, rig.s, s.model.solver.dt), 1u);
+    EXPECT_LT(colliderDistance(s.model.colliders[0], poses[0], unaware.state.particles.x.back(), nullptr), 0.0f) << collider;
+    EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, poses, rig.s, s.model.solver.dt), 0u) << collider;
+    EXPECT_EQ(s.state.particles.size(), size_t(s.model.numCloth));
+    EXPECT_DOUBLE_EQ(s.state.clothBuffer[mid], 1.25 * thr);
+    EXPECT_NEAR(accountedWater(s), before, 1e-12);
+  }
+  // the same sheet hung vertically 0.3 m above the floor drips below its bottom edge, clear of the floor
+  Scene v = sceneFromJson(R"({"colliders": [{"type": "plane"}], "cloth": [)" +
+                          rectangleJson("s", Vec3(0, 0.4f, 0), 0.2f, 0.2f, 11, 11, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
+                          R"(], "wetting": {}})");
+  StageRig rig;
+  rig.refresh(v.state, v.model);
+  v.state.clothBuffer[5] = 1.25 * v.model.wetting.massThreshold;  // bottom row, y = 0.3
+  const std::vector<ColliderPose> poses{colliderPose(v.model.colliders[0], 0.0)};
+  ASSERT_EQ(emitExcessWater(v.model, v.state, rig.nb, rig.grid, poses, rig.s, v.model.solver.dt), 1u);
+  EXPECT_LT(v.state.particles.x.back().y(), 0.3f);
 }
 
 TEST(WettingEmission, DripsMadeInOnePassDoNotCrowdEachOther) {
@@ -88,7 +143,7 @@ TEST(WettingEmission, DripsMadeInOnePassDoNotCrowdEachOther) {
   const float thr = s.model.wetting.massThreshold;
   for (size_t c = 0; c < 21; ++c) s.state.clothBuffer[c] = 1.25 * thr;  // row y = 0.9
   const double before = accountedWater(s);
-  const size_t made = emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, s.model.solver.dt);
+  const size_t made = emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, s.model.solver.dt);
   EXPECT_GE(made, 3u);
   EXPECT_LE(made, 21u);
   const Particles& p = s.state.particles;
@@ -119,7 +174,7 @@ TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
     for (int c = 0; c < 11; ++c) b += s.state.clothBuffer[size_t(r * 11 + c)];
     return b;
   };
-  for (int it = 0; it < 20; ++it) emitExcessWater(s.model, s.state, rig.nb, rig.grid, rig.s, s.model.solver.dt);
+  for (int it = 0; it < 20; ++it) emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, s.model.solver.dt);
   EXPECT_NEAR(accountedWater(s), before, 1e-12 * before);
   // held water is capped at S^EW
   for (float si : s.state.clothSaturation) EXPECT_LE(si, s.model.wetting.saturationEmit * (1.0f + 1e-5f));
@@ -131,9 +186,38 @@ TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
                              rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
                              R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
   rig.refresh(flat.state, flat.model);
-  emitExcessWater(flat.model, flat.state, rig.nb, rig.grid, rig.s, flat.model.solver.dt);
+  emitExcessWater(flat.model, flat.state, rig.nb, rig.grid, {}, rig.s, flat.model.solver.dt);
   const size_t mid = 10 * 11 + 5;
   EXPECT_NEAR(flat.state.clothBuffer[mid], (0.4 - 0.35) * rig.s.volume[mid] / flat.model.wetting.c, 1e-9);
+}
+
+// a buffer that already holds m^threshold (a drip that found no place: under water the water around is
+// at rest density) takes no more water, neither its particle's excess nor the flow from above, so a
+// sheet under water does not pump the pool into its buffers (Fig. 5's buffers grew by 0.4 kg every
+// 0.3 s, Fig. 9(b)'s reached 3 kg on one particle)
+TEST(WettingEmission, AFullBufferTakesNoMore) {
+  const char* kWet = R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})";
+  for (bool fullBuffer : {false, true}) {
+    Scene s = sceneFromJson(R"({"cloth": [)" +
+                            rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) + kWet);
+    StageRig rig;
+    rig.refresh(s.state, s.model);
+    const double thr = s.model.wetting.massThreshold;
+    const size_t k = 10 * 11 + 5, above = 11 * 11 + 5;  // a middle particle and the one above it
+    ASSERT_GT(s.state.particles.x[above].y(), s.state.particles.x[k].y());
+    s.state.clothBuffer[k] = fullBuffer ? thr : 0.0;
+    const double held = s.state.clothWater[k], before = accountedWater(s);
+    emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, s.model.solver.dt);
+    EXPECT_NEAR(accountedWater(s), before, 1e-12 * before);
+    if (fullBuffer) {
+      EXPECT_DOUBLE_EQ(s.state.clothWater[k], held);  // kept above S^EW: Eq. 11 stops absorbing at S^MAX
+      EXPECT_LE(s.state.clothBuffer[k], thr);         // it still sheds below; nothing came in
+    } else {
+      EXPECT_LT(s.state.clothWater[k], held);  // the excess went to the buffer
+      EXPECT_GT(s.state.clothBuffer[k], 0.0);
+    }
+    EXPECT_GT(s.state.clothBuffer[above], 0.0);  // the particle above has its own excess either way
+  }
 }
 
 TEST(WettingEmission, SaturatedHangingClothDrainsAndDrips) {

@@ -106,3 +106,14 @@ TEST(WettingParams, RefusesADripThresholdNoParticleCanHold) {
   // with emission off the threshold is never used
   EXPECT_EQ(errorOf({"wetting.emission.massThreshold=0.006", "wetting.emission.enabled=false"}), "");
 }
+
+TEST(WettingParams, RefusesALargestDripLighterThanTheThreshold) {
+  const std::string e = errorOf({"wetting.emission.maxDripMass=0.001"});
+  EXPECT_NE(e.find("<test>: at wetting.emission.maxDripMass: expected a number >= wetting.emission.massThreshold "
+                   "(0.002), got 0.001"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(errorOf({"wetting.emission.maxDripMass=0"}).find("at wetting.emission.maxDripMass"), std::string::npos);
+  EXPECT_EQ(errorOf({"wetting.emission.maxDripMass=0.002"}), "");
+  EXPECT_FLOAT_EQ(sceneFromJson(kHanging).model.wetting.maxDripMass, 0.0f);  // unset: four water particles' mass
+}
