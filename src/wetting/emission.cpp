@@ -313,11 +313,6 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const size_t gridSize = grid.cellEntries.size();
   const float mDrip = w.massThreshold;
   const float hDrip = std::cbrt(mDrip / m0) * h0;  // h_p = (m_p / m0)^(1/3) h0
-  // the sources, in cloth order; then, in parallel, each one's first placement that the density
-  // before this stage's drips allows (a placement it crowds stays crowded: the drips made below only
-  // add density); then, serially in cloth order, the drips made before it are added, and a placement
-  // they crowd moves on to the next ones. The same drips, places and sums as trying every placement
-  // serially, with the density's terms added in the same order
   // a place inside a collider (below a sheet lying on the floor or on a ball) would be pushed out at
   // the next substep, through the far side of a thin floor or flung off the ball (departure: docs/models.md)
   const float clearance = contactMargin(model, kWaterPhase);
@@ -330,6 +325,11 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const auto place = [&](const DripDirections& along, const Vec3& xi, int t, Vec3& y) {
     return along.placement(xi, hDrip, t, y) && clearOfColliders(y);
   };
+  // the sources, in cloth order; then, in parallel, each one's first placement that the density
+  // before this stage's drips allows (a placement it crowds stays crowded: the drips made below only
+  // add density); then, serially in cloth order, the drips made before it are added, and a placement
+  // they crowd moves on to the next ones. The same drips, places and sums as trying every placement
+  // serially, with the density's terms added in the same order
   std::vector<int32_t>& sources = s.dripSources;
   sources.clear();
   for (int64_t i = 0; i < nc; ++i)
