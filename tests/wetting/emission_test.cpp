@@ -203,18 +203,20 @@ TEST(WettingEmission, AFullBufferTakesNoMore) {
     StageRig rig;
     rig.refresh(s.state, s.model);
     const double thr = s.model.wetting.massThreshold;
-    const size_t k = 10 * 11 + 5, above = 11 * 11 + 5;  // a middle particle and the one above it
+    const size_t k = 5, above = 11 + 5;  // the middle of the bottom row (nothing below it) and the one above
     ASSERT_GT(s.state.particles.x[above].y(), s.state.particles.x[k].y());
     s.state.clothBuffer[k] = fullBuffer ? thr : 0.0;
     const double held = s.state.clothWater[k], before = accountedWater(s);
-    emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, s.model.solver.dt);
+    const size_t made = emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, s.model.solver.dt);
     EXPECT_NEAR(accountedWater(s), before, 1e-12 * before);
     if (fullBuffer) {
       EXPECT_DOUBLE_EQ(s.state.clothWater[k], held);  // kept above S^EW: Eq. 11 stops absorbing at S^MAX
-      EXPECT_LE(s.state.clothBuffer[k], thr);         // it still sheds below; nothing came in
+      EXPECT_EQ(made, 1u);                             // the full buffer made its drip (in air here)
+      EXPECT_DOUBLE_EQ(s.state.clothBuffer[k], 0.0);  // and nothing came in, from it or from above
     } else {
-      EXPECT_LT(s.state.clothWater[k], held);  // the excess went to the buffer
-      EXPECT_GT(s.state.clothBuffer[k], 0.0);
+      EXPECT_EQ(made, 0u);
+      EXPECT_LT(s.state.clothWater[k], held);  // the excess went to the buffer, and more came from above
+      EXPECT_GT(s.state.clothBuffer[k], held - s.state.clothWater[k]);
     }
     EXPECT_GT(s.state.clothBuffer[above], 0.0);  // the particle above has its own excess either way
   }
