@@ -3,6 +3,7 @@
 #include "pbd/cloth.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/parallel.hpp"
@@ -164,6 +165,15 @@ void stretchRange(int begin, int end, const int* __restrict I, const float* __re
   }
 }
 
+// adds the moves of constraints [begin, end) of one colour to their V vertices (component c of
+// constraint k at corr[c * stride + k], as stretchRange and bendRange write them): scatters
+template <size_t V>
+void addMoves(int begin, int end, const std::array<int, V>* ids, const float* corr, size_t stride, Vec3* x) {
+  for (int k = begin; k < end; ++k)
+    for (size_t v = 0; v < V; ++v)
+      x[ids[k][v]] += Vec3(corr[(3 * v) * stride + k], corr[(3 * v + 1) * stride + k], corr[(3 * v + 2) * stride + k]);
+}
+
 void bendRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
                const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
                float* __restrict lambda, float* __restrict out, size_t strideSize) {
@@ -199,18 +209,12 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   const auto stretchBlock = [&](int begin, int end) {
     stretchRange(begin, end, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
                  stretchLambda, corrStretch, strideStretch);
-    for (int k = begin; k < end; ++k)
-      for (int v = 0; v < 2; ++v)
-        x[st.ids[k][v]] += Vec3(corrStretch[(3 * v) * strideStretch + k], corrStretch[(3 * v + 1) * strideStretch + k],
-                                corrStretch[(3 * v + 2) * strideStretch + k]);
+    addMoves(begin, end, st.ids.data(), corrStretch, strideStretch, x);
   };
   const auto bendBlock = [&](int begin, int end) {
     bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
               bendLambda, corrBend, strideBend);
-    for (int k = begin; k < end; ++k)
-      for (int v = 0; v < 4; ++v)
-        x[bd.ids[k][v]] += Vec3(corrBend[(3 * v) * strideBend + k], corrBend[(3 * v + 1) * strideBend + k],
-                                corrBend[(3 * v + 2) * strideBend + k]);
+    addMoves(begin, end, bd.ids.data(), corrBend, strideBend, x);
   };
   // one group: its stretch constraints colour by colour, then its bend constraints
   const ConstraintSchedule& ss = st.schedule;
