@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# installs the Debian 12 packages soak needs (only those missing) and builds it in Release into build/
+# installs the Debian 12 packages soak needs (only those missing) and builds it in Release into build/.
+# The list is complete for a fresh minimal Debian 12 (apt-get --no-install-recommends pulls no extras):
+# scripts/check-fresh.sh proves it in a debootstrap root, and CI runs that check.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev
           libtinyobjloader-dev libgtest-dev libgmock-dev
-          libopenvdb-dev libboost-iostreams-dev povray ffmpeg)
+          libopenvdb-dev libboost-iostreams-dev zlib1g-dev povray ffmpeg)
+# zlib1g-dev: OpenVDB's CMake module (FindOpenVDB.cmake) requires ZLIB but its package does not depend on it
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
