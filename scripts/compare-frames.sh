@@ -6,7 +6,8 @@
 #
 #   scripts/compare-frames.sh BASE [SCENE.json ...]
 #
-# Environment: FRAMES (default 10), THREADS (default "1 2"), COMPARE_DIR (default out/compare).
+# Environment: FRAMES (default 10), THREADS (default "1 2"), COMPARE_DIR (default out/compare),
+# BASE_ONLY=1 (only build and run the base, e.g. while the working tree is being changed).
 # The base build (build-base/) and its frames (COMPARE_DIR/base-SHA/) are kept, so a second run only
 # simulates the working tree. Needs python3 for the stats comparison. Exit 1 when anything differs.
 set -euo pipefail
@@ -29,7 +30,7 @@ if [ ! -x build-base/soak ] || [ "$(cat build-base/SHA 2> /dev/null)" != "$base_
   cp build-base/build/soak build-base/soak
   echo "$base_sha" > build-base/SHA
 fi
-cmake --build build --target soak -j "$(nproc)"
+[ "${BASE_ONLY:-0}" = 1 ] || cmake --build build --target soak -j "$(nproc)"
 
 # runs one scene with one binary into $1 unless it is there already
 run_scene() {
@@ -57,6 +58,7 @@ for scene in "${scenes[@]}"; do
     n="$dir/new/$name/t$t"
     rm -rf "$n"
     run_scene build-base/soak "$scene" "$b" "$t"
+    [ "${BASE_ONLY:-0}" = 1 ] && { echo "base      $name, $t thread(s)"; continue; }
     run_scene build/soak "$scene" "$n" "$t"
     bad=()
     for f in "$b"/*; do
