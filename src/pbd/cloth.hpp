@@ -6,34 +6,14 @@
 
 #include "grid/grid.hpp"
 
-#include <string>
 #include <vector>
 
 namespace soak {
 
-// a triangle mesh as read from OBJ or generated; positions in metres
-struct TriangleMesh {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<int, 3>> triangles;
-};
-
-// reads an OBJ file (triangulating polygons); throws soak::Error naming the file on failure
-TriangleMesh loadObjMesh(const std::string& path);
-
-// a rectangle of size (width x height) m with (resX x resY) vertices, centred at `center`, lying in
-// the plane spanned by unit axes `axisU` (width) and `axisV` (height); alternating diagonals
-TriangleMesh makeRectangle(const Vec3& center, const Vec3& axisU, const Vec3& axisV, float width, float height,
-                           int resX, int resY);
-
-// appends a cloth piece to the model: particles' rest data, triangles, and rebuilds stretch/bend
-// constraints, colourings and adjacency. Throws soak::Error (naming `source`) when an edge is shared
-// by more than two triangles, a triangle is degenerate or an index is out of range. An Implicit
-// piece gets adjacency but no PBD stretch / bend constraints (src/garment builds its springs).
-void addClothPiece(Model& model, const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
-                   const std::vector<int>& pinnedVertices, const std::string& source,
-                   ClothSolver solver = ClothSolver::Pbd);
-
-// the particle index of vertex 0 of the piece is model.pieces[k].firstParticle
+// rebuilds model.stretch and model.bend from the triangles of the PBD pieces (Eq. 8: one stretch
+// constraint per edge; Eq. 9: one bend constraint per interior edge), coloured and scheduled
+// (ConstraintSchedule). Implicit pieces get none: src/garment builds their springs.
+void buildClothConstraints(Model& model);
 
 // scratch for the cloth solver (XPBD multipliers)
 struct ClothScratch {

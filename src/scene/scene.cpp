@@ -12,9 +12,10 @@
 #include <optional>
 #include <sstream>
 
-#include "pbd/cloth.hpp"
+#include "garment/stage.hpp"
 #include "pbd/tethers.hpp"
 #include "scene/chen_keys.hpp"
+#include "scene/cloth_piece.hpp"
 #include "scene/common.hpp"
 #include "scene/overrides.hpp"
 #include "scene/reader.hpp"
@@ -612,6 +613,7 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
     piece.panelOfVertex = c.panelOfVertex;
   }
   buildTethers(model);
+  buildGarmentPieces(model);  // Chen 2012 springs of the implicit pieces
   Particles& p = scene.state.particles;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];

@@ -3,7 +3,7 @@
 #pragma once
 #include <soak/model.hpp>
 
-#include "pbd/cloth.hpp"
+#include "world/mesh.hpp"
 
 #include <array>
 #include <string>

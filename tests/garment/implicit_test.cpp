@@ -13,7 +13,7 @@
 #include <cstring>
 #include <random>
 
-#include "pbd/cloth.hpp"
+#include "scene/cloth_piece.hpp"
 
 namespace soak {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "garment/saturation_mass.hpp"
 #include "garment/wet_friction.hpp"
-#include "pbd/cloth.hpp"
+#include "scene/cloth_piece.hpp"
 
 namespace soak {
 namespace {

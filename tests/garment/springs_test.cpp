@@ -9,7 +9,7 @@
 #include <random>
 #include <set>
 
-#include "pbd/cloth.hpp"
+#include "world/mesh.hpp"
 
 namespace soak {
 namespace {

@@ -8,7 +8,7 @@
 #include <deque>
 #include <set>
 
-#include "pbd/cloth.hpp"
+#include "scene/cloth_piece.hpp"
 
 namespace soak {
 namespace {

@@ -1,6 +1,7 @@
 // PBD cloth: the constraints of Eq. 8 and 9 (values and gradients), the XPBD solver on a hanging sheet
 // (Shao 2017 section 3.2), determinism across thread counts, and self-collision.
 #include "pbd/cloth.hpp"
+#include "scene/cloth_piece.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>

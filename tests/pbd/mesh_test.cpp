@@ -13,6 +13,7 @@
 #include <soak/error.hpp>
 
 #include "pbd/cloth.hpp"
+#include "scene/cloth_piece.hpp"
 
 namespace soak {
 namespace {

@@ -4,7 +4,7 @@
 #include "world/garment_mesh.hpp"
 #include "world/mannequin.hpp"
 
-#include "pbd/cloth.hpp"
+#include "scene/cloth_piece.hpp"
 #include "world/colliders.hpp"
 
 #include <soak/error.hpp>
