@@ -29,6 +29,9 @@ enum class ColliderShape { Plane, Box, Container, Sphere, Capsule, Mesh };
 // signed distance grid of a closed triangle mesh (src/world/mesh_sdf.hpp); immutable once built
 struct SdfGrid;
 
+// springs, system pattern and wrinkle subdomains of a piece solved implicitly (src/garment/implicit.hpp)
+struct GarmentPiece;
+
 struct Collider {
   std::string name;
   ColliderShape shape = ColliderShape::Plane;
@@ -85,6 +88,9 @@ struct ClothPiece {
   bool wetByContact = false;        // the piece keeps a wet start time per vertex (State::clothWetStart)
   bool dropsVanish = true;          // a water particle that wets the piece (no Shao wetting) is taken in
   std::vector<int> panelOfVertex;   // wrinkle subdomains of a procedural garment; empty: patches
+  // Implicit pieces: their constant garment data, built by the scene loader (buildGarmentPieces);
+  // shared and read-only, so a Model copy stays cheap
+  std::shared_ptr<const GarmentPiece> implicit;
 };
 
 // the order the cloth solver projects a set of constraints in (src/pbd/cloth.cpp). The cloth

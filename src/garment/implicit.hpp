@@ -13,8 +13,8 @@
 //   auto wr = computeDisturbances(model, k, g.springs, g.subdomains, p, poses, params.wrinkles, step);
 //   implicitStep(model, g, params, time, h, poses, wetStart, wr, p, scratch);  // Eq. 1-5, contact
 // It reads x, v, mass of the piece and writes xPred (= x1) and v (= v1); x is left for the caller's
-// commit (x = xPred). The PBD stages must skip the piece: no predictPositions, solveCloth,
-// updateVelocities for it.
+// commit (x = xPred). The PBD stages leave the piece alone: predictPositions, solveCloth and
+// updateVelocities move only the particles of pbdParticles (pbd/integrate.hpp).
 #pragma once
 #include <soak/model.hpp>
 #include <soak/state.hpp>

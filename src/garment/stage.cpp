@@ -11,9 +11,16 @@ namespace soak {
 
 namespace {
 
-void build(const Model& model, GarmentScratch& s) {
-  s.slot.assign(model.pieces.size(), -1);
-  s.pieces.clear();
+std::span<const float> pieceWetStart(const State& state, const ClothPiece& piece) {
+  if (state.clothWetStart.size() < static_cast<size_t>(piece.firstParticle + piece.particleCount)) return {};
+  return std::span<const float>(state.clothWetStart).subspan(static_cast<size_t>(piece.firstParticle),
+                                                             static_cast<size_t>(piece.particleCount));
+}
+
+}  // namespace
+
+void buildGarmentPieces(Model& model) {
+  std::vector<std::shared_ptr<const GarmentPiece>> built(model.pieces.size());
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];
     if (piece.solver != ClothSolver::Implicit) continue;
@@ -25,20 +32,10 @@ void build(const Model& model, GarmentScratch& s) {
       g.subdomains.clear();
       for (auto& [id, vertices] : panels) g.subdomains.push_back(std::move(vertices));
     }
-    s.slot[k] = static_cast<int>(s.pieces.size());
-    s.pieces.push_back(std::move(g));
+    built[k] = std::make_shared<const GarmentPiece>(std::move(g));
   }
-  s.scratch.resize(s.pieces.size());
-  s.built = true;
+  for (size_t k = 0; k < model.pieces.size(); ++k) model.pieces[k].implicit = std::move(built[k]);
 }
-
-std::span<const float> pieceWetStart(const State& state, const ClothPiece& piece) {
-  if (state.clothWetStart.size() < static_cast<size_t>(piece.firstParticle + piece.particleCount)) return {};
-  return std::span<const float>(state.clothWetStart).subspan(static_cast<size_t>(piece.firstParticle),
-                                                             static_cast<size_t>(piece.particleCount));
-}
-
-}  // namespace
 
 std::vector<float> clothWetness(const Model& model, const State& state) {
   std::vector<float> wet(static_cast<size_t>(model.numCloth), 0.0f);
@@ -61,8 +58,8 @@ float touchDistance(const Model& model, const ClothPiece& piece) {
 
 void solveGarments(const Model& model, State& state, GarmentScratch& s, const std::vector<ColliderPose>& poses,
                    float h, StepStats& stats) {
-  if (!s.built) build(model, s);
   Particles& p = state.particles;
+  s.scratch.resize(model.pieces.size());
   GarmentStats& gs = stats.garment;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];
@@ -72,9 +69,9 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
         applySaturationMass(model, static_cast<int>(k), wetStart, state.time, piece.garment.saturation, p);
       continue;
     }
-    const int slot = s.slot[k];
-    const ImplicitStats r = garmentSubstep(model, s.pieces[size_t(slot)], piece.garment, wetStart, state.time, h,
-                                           state.stepCount, poses, p, s.scratch[size_t(slot)]);
+    if (!piece.implicit) continue;  // a Model built without the loader's buildGarmentPieces
+    const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, wetStart, state.time, h,
+                                           state.stepCount, poses, p, s.scratch[k]);
     ++gs.solves;
     gs.cgIterations += static_cast<uint64_t>(r.cgIterations);
     gs.cgIterationsMax = std::max(gs.cgIterationsMax, r.cgIterations);
@@ -84,7 +81,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.contacts += static_cast<uint64_t>(r.contacts);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
   }
-  if (s.pieces.empty()) return;
+  if (!model.hasImplicitCloth()) return;
   // remember where the solve put the implicit cloth, so the coupling's push can become velocity
   s.solved.resize(static_cast<size_t>(model.numCloth));
   for (int64_t i = 0; i < model.numCloth; ++i)
@@ -92,7 +89,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
 }
 
 void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch& s, float h) {
-  if (s.pieces.empty() || s.solved.size() < static_cast<size_t>(model.numCloth)) return;
+  if (!model.hasImplicitCloth() || s.solved.size() < static_cast<size_t>(model.numCloth)) return;
   const float inv = 1.0f / h;
   parallelFor(model.numCloth, [&](int64_t i) {
     if (!model.implicitCloth(i)) return;

@@ -15,16 +15,18 @@
 
 namespace soak {
 
+// builds ClothPiece::implicit of every piece with "solver": "implicit" (springs, system pattern, and
+// the wrinkle subdomains: the garment's panels where it has them, else patches); the scene loader
+// calls it once the pieces are complete
+void buildGarmentPieces(Model& model);
+
 struct GarmentScratch {
-  bool built = false;
-  std::vector<int> slot;                 // per cloth piece: index into pieces / scratch, -1 for a PBD piece
-  std::vector<GarmentPiece> pieces;      // springs and system pattern of each implicit piece, built once
-  std::vector<ImplicitScratch> scratch;
+  std::vector<ImplicitScratch> scratch;  // per cloth piece (used by the implicit ones)
   std::vector<Vec3> solved;              // xPred of the implicit cloth particles right after their solve
   std::vector<int32_t> touch;            // per particle: the cloth vertex a water particle wets, or -1
 };
 
-// before the PBD stages, after predictPositions (which skips implicit cloth): sets the Eq. 15-19 mass
+// before the PBD stages, after predictPositions (which moves only water and PBD cloth): sets the Eq. 15-19 mass
 // of every piece with garment.saturationMass, then runs garmentSubstep (Eq. 1-5, wrinkles, contact
 // with wet friction) for every implicit piece, writing its xPred and v. poses are the colliders at
 // state.time + h.
@@ -32,7 +34,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
                    float h, StepStats& stats);
 
 // after the water coupling (Eq. 21), which may have moved implicit cloth: adds that displacement over
-// h to its velocity (updateVelocities skips implicit cloth). A piece whose drops vanish (no Shao
+// h to its velocity (updateVelocities moves only water and PBD cloth). A piece whose drops vanish (no Shao
 // wetting) is not moved by the water: the displacement is undone (one-way coupling)
 void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch& s, float h);
 

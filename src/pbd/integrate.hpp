@@ -3,6 +3,7 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
+#include "core/parallel.hpp"
 #include "pbd/fluid.hpp"
 #include "world/colliders.hpp"
 
@@ -10,11 +11,15 @@
 
 namespace soak {
 
-// v += dt g; x* = x + dt v for free particles; pinned cloth follows its rest position
-void predictPositions(const Model& model, double time, Particles& p, float dt);
+// the particles the PBD stages move, as ranges: the PBD cloth pieces' and the water (of n particles);
+// the implicit pieces' are moved by src/garment
+void pbdParticles(const Model& model, size_t n, std::vector<IndexRange>& ranges);
 
-// v = (x* - x) / dt, with the cloth's velocity damping
-void updateVelocities(const Model& model, Particles& p, float dt);
+// v += dt g; x* = x + dt v for the particles in `moved`; pinned cloth follows its rest position
+void predictPositions(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt);
+
+// v = (x* - x) / dt for the particles in `moved`, with the cloth's velocity damping
+void updateVelocities(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt);
 
 // x = x*
 void commitPositions(Particles& p);
@@ -31,7 +36,6 @@ float maxSupportRadius(const Particles& p);
 // their size; when more than an eighth of the particles are above it (heavy rain drops), the largest
 // radius of all
 float neighborCellSize(const Model& model, const Particles& p);
-float maxSpeed(const Particles& p);
 float meanDensityRatio(const Model& model, const Particles& p, const FluidScratch& s);
 
 }  // namespace soak

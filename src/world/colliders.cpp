@@ -251,11 +251,12 @@ float contactMargin(const Model& model, int32_t phase) {
 void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal) {
   std::vector<float> distanceBound;
-  projectColliders(model, poses, p, dt, contactNormal, distanceBound);
+  projectColliders(model, poses, p, {{0, static_cast<int64_t>(p.size())}}, dt, contactNormal, distanceBound);
 }
 
-void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
-                      std::vector<Vec3>& contactNormal, std::vector<float>& distanceBound) {
+void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
+                      const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
+                      std::vector<float>& distanceBound) {
   const int64_t n = static_cast<int64_t>(p.size());
   contactNormal.assign(p.size(), Vec3::Zero());
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
@@ -266,8 +267,8 @@ void projectColliders(const Model& model, const std::vector<ColliderPose>& poses
   distanceBound.assign(p.size(), std::numeric_limits<float>::max());
   for (size_t c = 0; c < numColliders; ++c)
     colliderDistanceBounds(model.colliders[c], poses[c], p.xPred[0].data(), n, distanceBound.data());
-  parallelFor(n, [&](int64_t i) {
-    if (!(p.invMass[i] > 0.0f) || model.implicitCloth(i)) return;  // implicit cloth: contact in its own solve
+  parallelForRanges(moved, [&](int64_t i) {
+    if (!(p.invMass[i] > 0.0f)) return;
     const float margin = contactMargin(model, p.phase[i]);
     if (distanceBound[i] >= margin) return;
     Vec3 xp = p.xPred[i];

@@ -4,6 +4,8 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
+#include "core/parallel.hpp"
+
 #include <vector>
 
 namespace soak {
@@ -36,13 +38,15 @@ void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const f
 // thickness
 float contactMargin(const Model& model, int32_t phase);
 
-// pushes every predicted position x* out of every collider (distance >= margin), removing the
-// fraction `friction` of the tangential motion relative to the collider over this substep.
-// contactNormal[i] is set to the world normal of the last contact of particle i, or zero.
-// distanceBound: scratch, a lower bound of each particle's distance to the nearest collider, so that
-// the particles far from every collider skip the exact test
-void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
-                      std::vector<Vec3>& contactNormal, std::vector<float>& distanceBound);
+// pushes the predicted position x* of every particle in `moved` (but kinematic ones) out of every
+// collider (distance >= margin), removing the fraction `friction` of the tangential motion relative to
+// the collider over this substep. contactNormal[i] is set to the world normal of the last contact of
+// particle i, or zero. distanceBound: scratch, a lower bound of each particle's distance to the nearest
+// collider, so that the particles far from every collider skip the exact test
+void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
+                      const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
+                      std::vector<float>& distanceBound);
+// the same for every particle
 void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal);
 

@@ -25,6 +25,7 @@ struct Workspace {
   ClothScratch cloth;
   CouplingScratch coupling;
   std::vector<uint8_t> keep;            // particles kept after the domain check
+  std::vector<IndexRange> pbdParticles; // the particles the PBD stages move this substep (pbdParticles)
   WettingScratch wetting;               // cloth wetting (Shao 2017 section 4)
   GarmentScratch garment;               // implicit garments and saturation mass (Chen 2012)
   ReorderScratch reorder;               // keys and buffer of the water's sort by cell

@@ -1,0 +1,149 @@
+// the simulation loop of Algorithm 1 (Shao et al. 2017): one line per stage, each stage in its own file
+#include <soak/step.hpp>
+
+#include "core/parallel.hpp"
+#include "garment/stage.hpp"
+#include "pbd/integrate.hpp"
+#include "sim/diagnostics.hpp"
+#include "pbd/tethers.hpp"
+#include "sim/workspace.hpp"
+#include "world/emitters.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace soak {
+
+namespace {
+
+constexpr uint64_t kSortEverySteps = 10;  // the water moves less than a cell in 10 steps
+
+// the wall time of the stages: each call of lap adds the ms since the last one to a stage (and to
+// one of its parts)
+struct StageClock {
+  StageTimes& ms;
+  std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
+  void lap(double& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    stage += std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+  }
+  void lap(double& stage, StagePart part) {
+    const double before = stage;
+    lap(stage);
+    ms.part(part) += stage - before;
+  }
+};
+
+// x* of every particle: new water, gravity, the colliders' poses at the substep's end, and the
+// implicit garments' own step (Chen 2012: Eq. 1-5, 15-19, section 3.5)
+void predict(const Model& model, State& state, Workspace& ws, float h, StepStats& stats, StageClock& clock) {
+  stats.emittedParticles += emitWater(model, state, state.time, h);                 // Fig. 1 jet, Fig. 3 block
+  clock.lap(stats.ms.emit);
+  pbdParticles(model, state.particles.size(), ws.pbdParticles);                     // water and PBD cloth
+  predictPositions(model, ws.pbdParticles, state.particles, h);                    // v += dt g, x* = x + dt v
+  updateColliderPoses(model, state.time + h, ws.poses);
+  clock.lap(stats.ms.predict);
+  solveGarments(model, state, ws.garment, ws.poses, h, stats);
+  clock.lap(stats.ms.garment);
+}
+
+// the constraints on x*: water (Eq. 6-7) with the cloth as its boundary, cloth (Eq. 8-9), colliders
+// and the water-cloth coupling (Eq. 21-22)
+void project(const Model& model, State& state, Workspace& ws, float h, StepStats& stats, StageClock& clock) {
+  Particles& p = state.particles;
+  StageTimes& ms = stats.ms;
+  buildGrid(p.xPred, neighborCellSize(model, p), ws.grid);                         // neighbours of x*
+  clock.lap(ms.neighbors, StagePart::neighborsGrid);
+  buildNeighborLists(p.xPred, p.radius, ws.grid, ws.neighbors, static_cast<uint32_t>(model.numCloth));
+  clock.lap(ms.neighbors, StagePart::neighborsLists);
+  computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
+  scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
+  solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
+  clock.lap(ms.water);
+  solveTethers(model, p);                                                           // long range attachments first,
+  solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // then stretch Eq. 8, bend Eq. 9
+  clock.lap(ms.cloth, StagePart::clothSolve);
+  clothSelfCollision(model, p, ws.neighbors, ws.cloth);
+  clock.lap(ms.cloth, StagePart::clothSelfCollision);
+  projectColliders(model, ws.poses, p, ws.pbdParticles, h, ws.contactNormal, ws.colliderBound);  // friction
+  clock.lap(ms.colliders);
+  updateCouplingStiffness(model, state, ws.coupling.triangleStiffness);             // Eq. 22: wetter cloth lets water through
+  findCouplingCandidates(model, p, ws.coupling);                                    // triangles near each water particle's path
+  clock.lap(ms.coupling, StagePart::couplingSearch);
+  for (int it = 0; it < model.solver.couplingIterations; ++it)                     // water-cloth, Eq. 21-22
+    stats.couplingContacts += solveCoupling(model, p, ws.coupling, false);
+  solveCoupling(model, p, ws.coupling, true);                                       // no water crosses the cloth
+  clock.lap(ms.coupling, StagePart::couplingPasses);
+}
+
+// v from x* - x, then x = x*
+void updateVelocitiesAndCommit(const Model& model, Workspace& ws, Particles& p, float h, StepStats& stats,
+                               StageClock& clock) {
+  updateVelocities(model, ws.pbdParticles, p, h);                                   // v = (x* - x) / dt, damping
+  addCouplingVelocity(model, p, ws.garment, h);                                     // implicit cloth pushed by water
+  applyColliderRestitution(model, ws.poses, ws.contactNormal, p);
+  clock.lap(stats.ms.velocities);
+  fluidVelocityPass(model, p, ws.neighbors, ws.fluid, h, true);                     // XSPH, vorticity
+  clock.lap(stats.ms.velocities, StagePart::velocitiesXsph);
+  stats.meanDensityRatio = meanDensityRatio(model, p, ws.fluid);
+  commitPositions(p);                                                               // x = x*
+  clock.lap(stats.ms.velocities);
+}
+
+// the wetting stages of Shao 2017 section 4 over wetDt
+void wet(const Model& model, State& state, Workspace& ws, float wetDt, StageClock& clock) {
+  const auto lap = [&](StagePart part) { clock.lap(clock.ms.wetting, part); };
+  updatePorosity(model, state, ws.neighbors, ws.wetting);                           // V_i, S_i, wet mass (Eq. 10)
+  lap(StagePart::wettingPorosity);
+  absorbWater(model, state, ws.neighbors, ws.wetting, wetDt);                       // water soaks in (Eq. 11)
+  lap(StagePart::wettingAbsorption);
+  diffuseWater(model, state, ws.neighbors, ws.wetting, wetDt);                      // spreads in the cloth (Eq. 12-17)
+  lap(StagePart::wettingDiffusion);
+  emitExcessWater(model, state, ws.neighbors, ws.grid, ws.poses, ws.wetting, wetDt);  // excess runs down, drips (Eq. 18)
+  lap(StagePart::wettingEmission);
+  applyDripAttraction(model, state, ws.neighbors, ws.wetting, wetDt);               // cloth holds its drips (Eq. 19)
+  lap(StagePart::wettingAttraction);
+  applySticking(model, state, ws.neighbors, ws.wetting, wetDt);                     // wet cloth sticks (Eq. 20)
+  lap(StagePart::wettingSticking);
+  finishWetting(model, state, ws.wetting);                                          // absorbed water leaves; ledger
+  lap(StagePart::wettingFinish);
+}
+
+// one substep of Algorithm 1. wetDt: the time the wetting stages cover, 0 to skip them (the step's
+// dt after its last substep, or the substep's h after each with wetting.everySubstep)
+void substep(const Model& model, State& state, Workspace& ws, float h, float wetDt, StepStats& stats) {
+  StageClock clock{stats.ms};
+  predict(model, state, ws, h, stats, clock);                                       // x* = x + dt v
+  project(model, state, ws, h, stats, clock);                                       // neighbours, constraints
+  updateVelocitiesAndCommit(model, ws, state.particles, h, stats, clock);           // v, then x = x*
+  if (wetDt > 0.0f) wet(model, state, ws, wetDt, clock);                            // absorb, diffuse, drip, stick
+  clock.lap(stats.ms.wetting);
+  stats.garment.dropsTaken += wetClothByContact(model, state, ws.neighbors, ws.garment, ws.keep, state.time + h);
+  clock.lap(stats.ms.garment);                                                      // Chen 2012: wet by contact
+  stats.removedParticles += removeOutsideDomain(model, state, ws.keep);             // counted in the ledger
+  clock.lap(stats.ms.velocities);
+  state.time += h;
+}
+
+}  // namespace
+
+void WorkspaceDeleter::operator()(Workspace* w) const { delete w; }
+WorkspacePtr makeWorkspace() { return WorkspacePtr(new Workspace()); }
+
+void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats) {
+  const auto start = std::chrono::steady_clock::now();
+  const int n = std::max(1, model.solver.substeps);
+  const float h = dt / static_cast<float>(n);
+  if (state.stepCount % kSortEverySteps == 0)                                       // water in cell order:
+    sortParticlesByCell(state.particles, model.numCloth, model.water.supportRadius, ws.reorder);  // neighbours close in memory
+  // Algorithm 1's wetting once a step at its dt; the substeps refine the dynamics only (departure: docs/models.md)
+  const bool every = model.wetting.everySubstep;
+  for (int s = 0; s < n; ++s) substep(model, state, ws, h, every ? h : (s + 1 == n ? dt : 0.0f), stats);
+  stats.substeps += n;
+  stats.maxSpeed = maxSpeed(state.particles);
+  ++state.stepCount;
+  stats.ms.total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace soak
