@@ -19,6 +19,12 @@ struct Particles {
   std::vector<Vec3> v;            // m/s
 
   size_t size() const { return x.size(); }
+  // mass m (kg) and its inverse together, 0 for a kinematic (pinned) particle: every stage that moves
+  // water into or out of a particle writes its mass through this
+  void setMass(size_t i, float m, bool kinematic) {
+    mass[i] = m;
+    invMass[i] = kinematic ? 0.0f : 1.0f / m;
+  }
   void resize(size_t n);
   // append one particle; returns its index
   size_t add(int32_t phase, uint32_t id, float mass, float radius, const Vec3& x, const Vec3& v);

@@ -4,17 +4,39 @@
 #pragma once
 #include <soak/math.hpp>
 
+#include <cmath>
+
 namespace soak {
 
 inline float pairRadius(float hi, float hj) { return 0.5f * (hi + hj); }
+
+// The kernels' normalisations, the only place their constants are written. The loops that vectorise
+// (pbd/fluid.cpp, wetting/) call these small functions with the same arithmetic as the kernels below,
+// so their results are the kernels' bit for bit.
+constexpr float kPoly6Norm = 315.0f / (64.0f * kPi);  // W_poly6 h^9 / (h^2 - r^2)^3
+constexpr float kSpikyGradNorm = -45.0f / kPi;        // |grad W_spiky| h^6 / (h - r)^2, negative
+// 315 / (64 pi h^9), h2 = h^2
+inline float poly6Coef(float h, float h2) { return 315.0f / (64.0f * kPi * (h2 * h2 * h2 * h2 * h)); }
+// -45 / (pi h^6), h3 = h^3: the factor of (h - r)^2 r_hat in grad W_spiky
+inline float spikyGradCoef(float h3) { return -45.0f / (kPi * h3 * h3); }
+// 45 / (pi h^6), h3 = h^3: the factor of (h - r) in the viscosity kernel's Laplacian
+inline float viscosityLaplacianCoef(float h3) { return 45.0f / (kPi * h3 * h3); }
+// the same factors from 1 / h, with one division a pair instead of one per factor
+inline float poly6CoefOfInverse(float inv) {
+  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+  return kPoly6Norm * inv6 * inv3;
+}
+inline float spikyGradCoefOfInverse(float inv) {
+  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+  return kSpikyGradNorm * inv6;
+}
 
 // W_poly6(r, h) = 315 / (64 pi h^9) (h^2 - r^2)^3 for r < h
 inline float poly6(float r2, float h) {
   const float h2 = h * h;
   if (r2 >= h2) return 0.0f;
   const float d = h2 - r2;
-  const float h9 = h2 * h2 * h2 * h2 * h;
-  return 315.0f / (64.0f * kPi * h9) * d * d * d;
+  return poly6Coef(h, h2) * d * d * d;
 }
 
 // grad W_spiky(r, h) = -45 / (pi h^6) (h - r)^2 r_hat, with r = x_i - x_j
@@ -23,7 +45,7 @@ inline Vec3 spikyGrad(const Vec3& r, float h) {
   if (len >= h || len <= 1e-9f) return Vec3::Zero();
   const float h3 = h * h * h;
   const float d = h - len;
-  return (-45.0f / (kPi * h3 * h3) * d * d / len) * r;
+  return (spikyGradCoef(h3) * d * d / len) * r;
 }
 
 // poly6 and the spiky gradient for one support radius, with its constants computed once: loops over
@@ -36,8 +58,8 @@ struct KernelCache {
     h = hNew;
     h2 = h * h;
     const float h3 = h2 * h;
-    poly6Coef = 315.0f / (64.0f * kPi * (h2 * h2 * h2 * h2 * h));
-    spikyCoef = -45.0f / (kPi * h3 * h3);
+    poly6Coef = soak::poly6Coef(h, h2);
+    spikyCoef = spikyGradCoef(h3);
   }
   float poly6(float r2) const {
     if (r2 >= h2) return 0.0f;
@@ -64,7 +86,40 @@ inline float spiky(float r, float h) {
 inline float viscosityLaplacian(float r, float h) {
   if (r >= h) return 0.0f;
   const float h3 = h * h * h;
-  return 45.0f / (kPi * h3 * h3) * (h - r);
+  return viscosityLaplacianCoef(h3) * (h - r);
+}
+
+// a poly6 kernel of support h cut by a plane wall (pbd/boundary.cpp), with its factor
+// K pi / 4 = 315 / (256 h^9) computed once: loops over particles of one radius build it once
+struct WallKernel {
+  float h;
+  double quarterPiK;
+  explicit WallKernel(float support) : h(support), quarterPiK(315.0 / (256.0 * std::pow(double(support), 9))) {}
+};
+
+// fraction of the poly6 kernel's mass beyond a plane at signed distance d (m):
+// (K pi / 4) int_d^h (h^2 - z^2)^4 dz; dFraction receives its derivative wrt d
+inline float wallKernelFraction(float d, const WallKernel& kernel, float* dFraction) {
+  const float h = kernel.h;
+  const float ad = std::fabs(d);
+  if (ad >= h) {
+    if (dFraction) *dFraction = 0.0f;
+    return d > 0.0f ? 0.0f : 1.0f;
+  }
+  const double hh = h, z = ad, h2 = hh * hh;
+  auto antiderivative = [&](double t) {
+    const double t2 = t * t;
+    return h2 * h2 * h2 * h2 * t - 4.0 / 3.0 * h2 * h2 * h2 * t2 * t + 6.0 / 5.0 * h2 * h2 * t2 * t2 * t -
+           4.0 / 7.0 * h2 * t2 * t2 * t2 * t + t2 * t2 * t2 * t2 * t / 9.0;
+  };
+  const double k = kernel.quarterPiK;
+  const double beyond = k * (antiderivative(hh) - antiderivative(z));
+  const double q = h2 - z * z;
+  if (dFraction) *dFraction = static_cast<float>(-k * q * q * q * q);  // the same on both sides
+  return static_cast<float>(d >= 0.0f ? beyond : 1.0 - beyond);
+}
+inline float wallKernelFraction(float d, float h, float* dFraction) {
+  return wallKernelFraction(d, WallKernel(h), dFraction);
 }
 
 }  // namespace soak

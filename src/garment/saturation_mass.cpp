@@ -68,8 +68,7 @@ void applySaturationMass(const Model& model, int piece, std::span<const float> w
     const size_t i = static_cast<size_t>(pc.firstParticle + v);
     const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
     const float m = static_cast<float>(wetMass(model.clothDryMass[i], start, time, s));
-    p.mass[i] = m;
-    p.invMass[i] = model.clothPinned[i] ? 0.0f : 1.0f / m;
+    p.setMass(i, m, model.clothPinned[i]);
   });
 }
 

@@ -233,9 +233,6 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
                         NeighborLists& lists, uint32_t firstWater) {
   const size_t n = x.size();
   lists.firstWater = firstWater;
-  // unique over the process, not per object: flags marked on one lists object are not taken for another
-  static std::atomic<uint64_t> builds{0};
-  lists.generation = ++builds;
   lists.start.resize(n + 1);
   lists.mid.resize(n);
   lists.start[0] = 0;

@@ -97,7 +97,6 @@ struct NeighborLists {
   std::vector<uint32_t, UninitAllocator<uint32_t>> index;
   std::vector<uint32_t> mid;
   uint32_t firstWater = 0;              // the index split the lists were built with
-  uint64_t generation = 0;              // which build these are, unique in the process (0: none): derived data can tell it is current
   std::vector<float> px, py, pz, ph;   // scratch of the build: candidates' positions and radii in cellEntries order
   std::vector<std::vector<uint32_t>> chunkBuffers;  // scratch of the build: the lists of one round's chunks
   // scratch of the build: a dense grid of the particles' bounding box (buildNeighborLists); dense

@@ -51,29 +51,9 @@ void boundaryParts(const Model& model, const std::vector<ColliderPose>& poses, s
   }
 }
 
-float wallKernelFraction(float d, float h, float* dFraction) {
-  const float ad = std::fabs(d);
-  if (ad >= h) {
-    if (dFraction) *dFraction = 0.0f;
-    return d > 0.0f ? 0.0f : 1.0f;
-  }
-  const double hh = h, z = ad, h2 = hh * hh;
-  auto antiderivative = [&](double t) {
-    const double t2 = t * t;
-    return h2 * h2 * h2 * h2 * t - 4.0 / 3.0 * h2 * h2 * h2 * t2 * t + 6.0 / 5.0 * h2 * h2 * t2 * t2 * t -
-           4.0 / 7.0 * h2 * t2 * t2 * t2 * t + t2 * t2 * t2 * t2 * t / 9.0;
-  };
-  // K pi / 4 with K = 315 / (64 pi h^9); the last h's value kept per thread (nearly every call has the same h)
-  thread_local double lastH = -1.0, lastK = 0.0;
-  if (hh != lastH) lastH = hh, lastK = 315.0 / (256.0 * std::pow(hh, 9));
-  const double k = lastK;
-  const double beyond = k * (antiderivative(hh) - antiderivative(z));
-  const double q = h2 - z * z;
-  if (dFraction) *dFraction = static_cast<float>(-k * q * q * q * q);  // the same on both sides
-  return static_cast<float>(d >= 0.0f ? beyond : 1.0 - beyond);
-}
-
-float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, float h, Vec3* gradient) {
+float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, const WallKernel& kernel,
+                       Vec3* gradient) {
+  const float h = kernel.h;
   float empty = 1.0f;  // prod (1 - phi_k)
   Vec3 gradEmpty = Vec3::Zero();
   for (const BoundaryPart& part : parts) {
@@ -83,7 +63,7 @@ float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, fl
     const float d = colliderDistance(part.shape, part.pose, x, &n);
     if (d >= h) continue;
     float dphi = 0.0f;
-    const float keep = 1.0f - wallKernelFraction(d, h, &dphi);
+    const float keep = 1.0f - wallKernelFraction(d, kernel, &dphi);
     gradEmpty = gradEmpty * keep - empty * dphi * n;  // product rule on prod (1 - phi_k)
     empty *= keep;
   }

@@ -5,6 +5,7 @@
 #pragma once
 #include <soak/model.hpp>
 
+#include "core/kernels.hpp"
 #include "world/colliders.hpp"
 
 #include <limits>
@@ -25,11 +26,8 @@ struct BoundaryPart {
 // the convex parts of every collider at the given poses
 void boundaryParts(const Model& model, const std::vector<ColliderPose>& poses, std::vector<BoundaryPart>& parts);
 
-// fraction of the kernel's mass beyond a plane at signed distance d (m): (K pi / 4) int_d^h (h^2 - z^2)^4 dz
-// for poly6; dFraction receives its derivative wrt d
-float wallKernelFraction(float d, float h, float* dFraction);
-
-// the solid fraction phi of the kernel of a particle at x with support h, and its gradient wrt x
-float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, float h, Vec3* gradient);
+// the solid fraction phi of the kernel of a particle at x with support kernel.h, and its gradient wrt x
+float boundaryFraction(const std::vector<BoundaryPart>& parts, const Vec3& x, const WallKernel& kernel,
+                       Vec3* gradient);
 
 }  // namespace soak

@@ -43,15 +43,6 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
 
 namespace {
 
-// the kernel constants of one pair from its support radius h, with one division and no h^9 divisions
-inline float poly6CoefOf(float inv) {
-  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
-  return (315.0f / (64.0f * kPi)) * inv6 * inv3;
-}
-inline float spikyCoefOf(float inv) {
-  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
-  return (-45.0f / kPi) * inv6;
-}
 inline float poly6Of(float h2, float poly6Coef, float r2) {
   const float d = std::max(h2 - r2, 0.0f);
   return poly6Coef * d * d * d;
@@ -256,12 +247,12 @@ struct Kernel {
 };
 template <bool U>
 inline Kernel kernelOf(const PairInputs& in, __mmask16 m, __m512i j, float hi) {
-  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOf(in.invU)), set(spikyCoefOf(in.invU))};
+  if (U) return {set(in.hU), set(in.hU * in.hU), set(poly6CoefOfInverse(in.invU)), set(spikyGradCoefOfInverse(in.invU))};
   const __m512 hj = _mm512_mask_i32gather_ps(set(hi), m, j, in.H, 4);
   const __m512 h = mul(set(0.5f), add(set(hi), hj));
   const __m512 inv = _mm512_div_ps(set(1.0f), h);
   const __m512 inv3 = mul(mul(inv, inv), inv), inv6 = mul(inv3, inv3);
-  return {h, mul(h, h), mul(mul(set(315.0f / (64.0f * kPi)), inv6), inv3), mul(set(-45.0f / kPi), inv6)};
+  return {h, mul(h, h), mul(mul(set(kPoly6Norm), inv6), inv3), mul(set(kSpikyGradNorm), inv6)};
 }
 // spikyFactorOf per lane, 0 outside the support, at r = 0 and in masked lanes
 inline __m512 spikyFactor(const Kernel& k, __m512 r2, __mmask16 m) {
@@ -360,8 +351,8 @@ inline void densitySums(const PairInputs& in, size_t i, uint32_t k0, uint32_t k1
   for (; k < k1; ++k) {
     const auto [j, rx, ry, rz, r2, kh, kinv] = scalarPair<U>(in, k, xi, yi, zi, hi);
     const float mj = in.M[j];
-    r += mj * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
-    const float sf = spikyFactorOf(kh, spikyCoefOf(kinv), r2), f = mj * in.invRho0 * sf;
+    r += mj * poly6Of(kh * kh, poly6CoefOfInverse(kinv), r2);
+    const float sf = spikyFactorOf(kh, spikyGradCoefOfInverse(kinv), r2), f = mj * in.invRho0 * sf;
     if (in.cacheGx) {
       const float g = mj * sf;
       const uint32_t at = k - in.cacheBase;
@@ -457,7 +448,7 @@ inline Vec3 correctionSum(const PairInputs& in, size_t i, uint32_t k0, uint32_t 
     const float sc = Tensile && in.phase[j] == kWaterPhase
                          ? in.sCorrK * tensileCorrection(1.0f, in.oneMinusDq2, in.tensileN, r2, kh * kh)
                          : 0.0f;
-    const float f = in.M[j] * (li + in.L[j] + sc) * spikyFactorOf(kh, spikyCoefOf(kinv), r2);
+    const float f = in.M[j] * (li + in.L[j] + sc) * spikyFactorOf(kh, spikyGradCoefOfInverse(kinv), r2);
     dx += f * rx;
     dy += f * ry;
     dz += f * rz;
@@ -509,7 +500,7 @@ inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1,
     if (in.phase[i] != kWaterPhase || in.L[i] == 0.0f) continue;  // only compressed water pushes
     const float rx = X[3 * i] - xb, ry = X[3 * i + 1] - yb, rz = X[3 * i + 2] - zb;
     const float kh = U ? in.hU : 0.5f * (in.H[i] + hb), kinv = U ? in.invU : 1.0f / kh;
-    const float f = in.mass[i] * in.L[i] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz);
+    const float f = in.mass[i] * in.L[i] * spikyFactorOf(kh, spikyGradCoefOfInverse(kinv), rx * rx + ry * ry + rz * rz);
     dx -= f * rx;
     dy -= f * ry;
     dz -= f * rz;
@@ -560,8 +551,8 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const bool uniform = commonRadius(p.radius, hU);
   // mixed radii: the particles whose pairs all have h0 still take the constant-radius loops
   if (!uniform) hU = wp.supportRadius;
+  const WallKernel wallU(hU);  // the walls' kernel for the particles of radius hU
   markNeighbourhoods(p, nb, nc, wp.particleMass, hU, uniform ? nullptr : &s.mixedRadius, &s.plain);
-  s.mixedGeneration = uniform ? 0 : nb.generation;  // the velocity pass of the same lists takes these flags
   const uint8_t* const mixed = s.mixedRadius.data();
   const uint8_t* const plain = s.plain.data();
   PairInputs in{p.xPred[0].data(), H, s.massOrPsi.data(), p.invMass.data(), L, p.mass.data(), p.phase.data(),
@@ -602,7 +593,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
         // come within h of one (exact: a part beyond h adds nothing)
         Vec3 gradWall = -Vec3::Zero();
         if (!s.parts.empty() && s.wallClear[w] - 2.0f * (p.xPred[i] - s.wallFrom[w]).norm() < hi)
-          rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi, &gradWall);
+          rho += rho0 * boundaryFraction(s.parts, p.xPred[i], hi == hU ? wallU : WallKernel(hi), &gradWall);
         gradI += gradWall;
         s.delta[i] = gradWall;  // kept for the corrections below (same positions): one wall query per iteration
         s.density[i] = rho;
@@ -640,7 +631,8 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   withFlags(uniform, tensile, solve);
 }
 
-void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt) {
+void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt,
+                       bool listsOfSolve) {
   const WaterParams& wp = model.water;
   const size_t n = p.size();
   const int64_t nc = model.numCloth;
@@ -665,7 +657,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   // (the radii have not changed since solveFluid marked these lists: the wetting stages come after)
   if (!uniform) {
     hU = wp.supportRadius;
-    if (nb.generation == 0 || s.mixedGeneration != nb.generation) markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
+    if (!listsOfSolve) markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
   }
   const uint8_t* const mixed = s.mixedRadius.data();
   const float invU = 1.0f / hU;
@@ -683,12 +675,12 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
       // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
       const float vol = phase[j] == kWaterPhase ? 2.0f * M[j] / std::max(di + D[j], 1e-3f) : 0.0f;
       const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
-      const float wgt = vol * poly6Of(kh * kh, poly6CoefOf(kinv), r2);
+      const float wgt = vol * poly6Of(kh * kh, poly6CoefOfInverse(kinv), r2);
       bx += wgt * vx;
       by += wgt * vy;
       bz += wgt * vz;
       if (Vort) {
-        const float f = vol * spikyFactorOf(kh, spikyCoefOf(kinv), r2);  // v_ij x (f r)
+        const float f = vol * spikyFactorOf(kh, spikyGradCoefOfInverse(kinv), r2);  // v_ij x (f r)
         ox += f * (vy * rz - vz * ry);
         oy += f * (vz * rx - vx * rz);
         oz += f * (vx * ry - vy * rx);
@@ -722,7 +714,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
         const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
         const float kh = 0.5f * (hi + H[j]), kinv = 1.0f / kh;
         const float vol = phase[j] == kWaterPhase ? M[j] / std::max(D[j], 1e-3f) : 0.0f;
-        const float f = vol * O[j] * spikyFactorOf(kh, spikyCoefOf(kinv), rx * rx + ry * ry + rz * rz);
+        const float f = vol * O[j] * spikyFactorOf(kh, spikyGradCoefOfInverse(kinv), rx * rx + ry * ry + rz * rz);
         ex += f * rx;
         ey += f * ry;
         ez += f * rz;

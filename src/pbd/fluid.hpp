@@ -24,7 +24,6 @@ struct FluidScratch {
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
   std::vector<float> wallClear;    // m, per water particle: a lower bound of its distance to the nearest part at wallFrom
   std::vector<uint8_t> mixedRadius;  // 1: a pair of the particle's list has another radius than water.supportRadius
-  uint64_t mixedGeneration = 0;      // the lists' generation mixedRadius was marked for (solveFluid; 0: none)
   std::vector<uint8_t> plain;        // 1: a water particle of water.particleMass whose neighbours all are (markNeighbourhoods)
   std::vector<Vec3> wallFrom;      // m, where each water particle was when wallClear was measured
   // per entry of the water particles' neighbour lists, written by the lambda pass and read by the
@@ -44,7 +43,10 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
 void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
                 FluidScratch& s, int iterations);
 
-// XSPH viscosity and vorticity confinement on water velocities (after v = (x* - x)/dt)
-void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt);
+// XSPH viscosity and vorticity confinement on water velocities (after v = (x* - x)/dt).
+// listsOfSolve: nb are the lists solveFluid last ran on with s, and no radius has changed since, so its
+// mixed-radius flags (s.mixedRadius) hold; false marks them again
+void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt,
+                       bool listsOfSolve);
 
 }  // namespace soak

@@ -100,8 +100,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       p.mass[j] = 0.0f;
       return;
     }
-    p.mass[j] = after;
-    p.invMass[j] = 1.0f / after;
+    p.setMass(static_cast<size_t>(j), after, false);
     p.radius[j] = std::cbrt(after / m0) * h0;  // h' = (m'/m0)^(1/3) h0, the adaptive sampling of Eq. 11
     s.waterLost[j] = static_cast<double>(before) - static_cast<double>(after);  // exact: both are floats
   });
@@ -194,11 +193,8 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       state.clothWater[i] += gain;
       // the absorbed water brings its momentum (inelastic: the cloth particle gets heavier)
       const float mi = p.mass[i], dm = static_cast<float>(gain);
-      if (!model.clothPinned[i]) {
-        p.v[i] = (mi * p.v[i] + dm * p.v[j]) / (mi + dm);
-        p.invMass[i] = 1.0f / (mi + dm);
-      }
-      p.mass[i] = mi + dm;
+      if (!model.clothPinned[i]) p.v[i] = (mi * p.v[i] + dm * p.v[j]) / (mi + dm);
+      p.setMass(static_cast<size_t>(i), mi + dm, model.clothPinned[i]);  // dry + held: porosity's sum, in steps
     }
   });
   return whole;

@@ -21,6 +21,8 @@
 namespace soak {
 
 void diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h) {
+  s.pairFloat.prepare();  // the per-thread pair buffers of the loops below
+  s.pairDouble.prepare();
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   if (!w.enabled || !w.diffusion || nc == 0) return;
@@ -72,7 +74,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
       const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
       const float* const L = lap + begin;
       const float* const C = cosG + begin;
-      float* const W = threadBuffer<float>(count);
+      float* const W = s.pairFloat.get(count);
       const float rho0 = restDensity(i), kdL = kd, etaL = eta;  // locals: GCC does not vectorise
 #pragma omp simd                                                  // loads through the closure
       for (uint32_t k = 0; k < count; ++k) W[k] = (kdL * L[k] / rho0) * (1.0f + etaL * std::fabs(C[k]));
@@ -96,7 +98,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
       const uint32_t* const J = index + begin;
       const float* const L = lap + begin;
       const float* const C = cosG + begin;
-      double* const T = threadBuffer<double>(count);
+      double* const T = s.pairDouble.get(count);
       // locals: GCC does not vectorise loads through the closure
       const int32_t* const P = phase;
       const float* const SL = S;

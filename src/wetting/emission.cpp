@@ -109,6 +109,8 @@ struct DripDirections {
 
 size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
                        const std::vector<ColliderPose>& poses, WettingScratch& s, float h) {
+  s.pairFloat.prepare();  // the per-thread pair buffers of the loops below
+  s.pairDouble.prepare();
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   if (!w.enabled || !w.emission || nc == 0) return 0;
@@ -167,7 +169,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     const float* const X = xAll;
     const float* const SL = satAll;
     const float* const VL = volumeAll;
-    float* const Tx = threadBuffer<float>(3 * static_cast<size_t>(count));
+    float* const Tx = s.pairFloat.get(3 * static_cast<size_t>(count));
     float* const Ty = Tx + count;
     float* const Tz = Ty + count;
     const uint32_t clothL = cloth;
@@ -209,7 +211,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       const float* const C = cosG + begin;
       const float* const W = poly + begin;
       const int32_t* const P = phaseAll;
-      double* const T = threadBuffer<double>(count);
+      double* const T = s.pairDouble.get(count);
       const uint32_t clothL = cloth;
       const int32_t phu = P[u];
       const float vu = volumeAll[u];
@@ -251,7 +253,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       const float* const VL = volumeAll;
       const float* const OS = outScaleAll;
       const double* const B = bufferAll;
-      double* const T = threadBuffer<double>(count);
+      double* const T = s.pairDouble.get(count);
       const uint32_t clothL = cloth;
       const int32_t phk = P[k];
       const float vk = VL[k], osk = OS[k];
@@ -306,8 +308,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     const float after = std::min(before + static_cast<float>(state.clothBuffer[i]), maxDrip);
     if (!(after > before)) continue;
     state.clothBuffer[i] -= static_cast<double>(after) - static_cast<double>(before);  // exact: both floats
-    p.mass[q] = after;
-    p.invMass[q] = 1.0f / after;
+    p.setMass(static_cast<size_t>(q), after, false);
     p.radius[q] = std::cbrt(after / m0) * h0;
   }
   const size_t gridSize = grid.cellEntries.size();

@@ -50,8 +50,7 @@ namespace {
 void setWetMass(const Model& model, State& state, int64_t i) {
   Particles& p = state.particles;
   const float m = model.clothDryMass[i] + static_cast<float>(state.clothWater[i] + state.clothBuffer[i]);
-  p.mass[i] = m;
-  p.invMass[i] = model.clothPinned[i] ? 0.0f : 1.0f / m;
+  p.setMass(static_cast<size_t>(i), m, model.clothPinned[i]);
 }
 
 }  // namespace
@@ -132,8 +131,7 @@ void pairGeometryThen(const Model& model, const Particles& p, const NeighborList
       // poly6(r2, h)
       const float h2 = h * h;
       const float dq = h2 - r2;
-      const float h9 = h2 * h2 * h2 * h2 * h;
-      P6[e] = r2 >= h2 ? 0.0f : 315.0f / (64.0f * kPi * h9) * dq * dq * dq;
+      P6[e] = r2 >= h2 ? 0.0f : poly6Coef(h, h2) * dq * dq * dq;
       // cosGravity(x_i, x_j, g); rCos and rGrad are r where the value is kept and only guard the
       // divisions of the lanes the selects drop (no std::max: it returns a reference, a memory load)
       const float r = std::sqrt(r2);
@@ -143,10 +141,10 @@ void pairGeometryThen(const Model& model, const Particles& p, const NeighborList
       // viscosityLaplacian(r, h) and the factor of spikyGrad(x_i - x_j, h)
       const float h3 = h * h * h;
       const float dh = h - r;
-      L[e] = r >= h ? 0.0f : 45.0f / (kPi * h3 * h3) * dh;
+      L[e] = r >= h ? 0.0f : viscosityLaplacianCoef(h3) * dh;
       const bool inGrad = (r < h) & (r > 1e-9f);
       const float rGrad = inGrad ? r : 1.0f;
-      F[e] = inGrad ? -45.0f / (kPi * h3 * h3) * dh * dh / rGrad : 0.0f;
+      F[e] = inGrad ? spikyGradCoef(h3) * dh * dh / rGrad : 0.0f;
     }
     after(i);
   });

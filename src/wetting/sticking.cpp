@@ -15,16 +15,9 @@
 
 namespace soak {
 
-float stickingCoefficient(const WettingParams& w, float si, float sj) {
-  if (!(si > 0.0f) || !(sj > 0.0f)) return 0.0f;
-  const float st = w.saturationSticky;
-  const float f = w.stickingStrength - w.stickingRate * std::fabs((si - st) * (sj - st));
-  if (f <= 0.0f) return 0.0f;
-  const float ramp = st > 0.0f ? std::min(1.0f, si / st) * std::min(1.0f, sj / st) : 1.0f;
-  return f * ramp;
-}
-
 void applySticking(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h) {
+  s.pairFloat.prepare();  // the per-thread pair buffers of the loops below
+  s.pairDouble.prepare();
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   if (!w.enabled || !w.sticking || nc == 0) return;
@@ -52,7 +45,7 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
       const float* const H = radiusAll;
       const int32_t* const P = phaseAll;
       const float* const S = satAll;
-      float* const Tx = threadBuffer<float>(3 * static_cast<size_t>(count));
+      float* const Tx = s.pairFloat.get(3 * static_cast<size_t>(count));
       float* const Ty = Tx + count;
       float* const Tz = Ty + count;
       const uint32_t cloth = static_cast<uint32_t>(nc), self = static_cast<uint32_t>(i);
@@ -60,7 +53,6 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
       const float rxi = R[3 * i], ryi = R[3 * i + 1], rzi = R[3 * i + 2];
       const int32_t phi = P[i];
       const float stL = st, rateL = rate, strengthL = strength;
-      const float rampI = stL > 0.0f ? (si / stL < 1.0f ? si / stL : 1.0f) : 1.0f;  // min(1, S_i / S^T)
       // neighbours on the rest shape are not "touching": the cloth holds them, not the water
       const auto onRest = [=](uint32_t jj, float hij) {
         const float ex = rxi - R[3 * jj], ey = ryi - R[3 * jj + 1], ez = rzi - R[3 * jj + 2];
@@ -87,17 +79,13 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
         const uint32_t jj = isCloth ? j : self;  // water entries read i's own row, then drop out
         const float sj = S[jj];
         const float hij = 0.5f * (hi + H[jj]);  // pairRadius
-        // stickingCoefficient(w, S_i, S_j), S_i > 0 already
-        const float fc = strengthL - rateL * std::fabs((si - stL) * (sj - stL));
-        const float rampJ = stL > 0.0f ? (sj / stL < 1.0f ? sj / stL : 1.0f) : 1.0f;
-        const float coef = fc * (stL > 0.0f ? rampI * rampJ : 1.0f);
+        const float coef = stickingCoefficient(si, sj, stL, strengthL, rateL);  // 0 for a dry neighbour
         const float rx = X[3 * jj] - xi, ry = X[3 * jj + 1] - yi, rz = X[3 * jj + 2] - zi;  // x_j - x_i
         const float r2 = rx * rx + (ry * ry + rz * rz);
         const float h2 = hij * hij;
-        const bool ok = isCloth & (sj > 0.0f) & !onRest(jj, hij) & (fc > 0.0f) & (coef > 0.0f) & (r2 < h2) & (r2 >= 1e-18f);
+        const bool ok = isCloth & !onRest(jj, hij) & (coef > 0.0f) & (r2 < h2) & (r2 >= 1e-18f);
         // poly6(r2, h_ij) / poly6(0, h_ij)
-        const float h9 = h2 * h2 * h2 * h2 * hij;
-        const float kern = 315.0f / (64.0f * kPi * h9);
+        const float kern = poly6Coef(hij, h2);
         const float d = h2 - r2;
         const float w6 = kern * d * d * d, w0 = kern * h2 * h2 * h2;
         const float rs = ok ? r2 : 1.0f;

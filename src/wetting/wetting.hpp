@@ -13,6 +13,7 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
+#include "core/parallel.hpp"
 #include "grid/grid.hpp"
 #include "world/colliders.hpp"
 
@@ -26,18 +27,13 @@ namespace soak {
 // part of a cloth costs far more per particle than the dry part, and is rarely split evenly
 constexpr int64_t kWetChunk = 256;
 
-// a per-thread buffer of at least n values, for the per-pair terms of one particle's neighbour loop:
-// a vectorised loop writes them, a scalar loop then sums them in list order (the order of the sums
-// stays that of the scalar code, and with it every result)
-template <class T>
-inline T* threadBuffer(size_t n) {
-  thread_local std::vector<T> buffer;
-  if (buffer.size() < n) buffer.resize(n);
-  return buffer.data();
-}
-
 // scratch of the wetting stages, reused from pass to pass
 struct WettingScratch {
+  // per thread: the per-pair terms of one particle's neighbour loop; a vectorised loop writes them, a
+  // scalar loop then sums them in list order (the order of the sums, and every result, stays that of
+  // the scalar code)
+  ThreadBuffers<float> pairFloat;
+  ThreadBuffers<double> pairDouble;
   std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this pass
   std::vector<float> capacity;     // kg a cloth particle can still absorb (Eq. 11)
   std::vector<float> clothScale;   // share of its requests a cloth particle grants (Eq. 11)
@@ -181,8 +177,17 @@ void applyDripAttraction(const Model& model, State& state, const NeighborLists& 
 // sticking.cpp ------------------------------------------------------------------------------------
 
 // Eq. 20 coefficient of a touching pair, N: (eta^ad - kappa^ad |(S_i - S^T)(S_j - S^T)|)+, times a
-// wetness ramp min(1, S/S^T) of each particle so dry cloth does not stick; largest at S^T
-float stickingCoefficient(const WettingParams& w, float si, float sj);
+// wetness ramp min(1, S/S^T) of each particle so dry cloth does not stick; largest at S^T; 0 when
+// either particle is dry. Selects only: applySticking's vectorised loop calls it too
+inline float stickingCoefficient(float si, float sj, float st, float strength, float rate) {
+  const float fc = strength - rate * std::fabs((si - st) * (sj - st));
+  const float rampI = si / st < 1.0f ? si / st : 1.0f, rampJ = sj / st < 1.0f ? sj / st : 1.0f;
+  const float coef = fc * (st > 0.0f ? rampI * rampJ : 1.0f);
+  return (si > 0.0f) & (sj > 0.0f) & (fc > 0.0f) & (coef > 0.0f) ? coef : 0.0f;
+}
+inline float stickingCoefficient(const WettingParams& w, float si, float sj) {
+  return stickingCoefficient(si, sj, w.saturationSticky, w.stickingStrength, w.stickingRate);
+}
 
 // Eq. 20 between touching wet cloth particles (those far apart on the rest shape), applied to the
 // velocities; equal and opposite per pair

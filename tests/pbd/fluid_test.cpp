@@ -43,7 +43,7 @@ std::vector<float> densities(const Scene& scene) {
       const uint32_t j = nb.index[k];
       r += p.mass[j] * poly6((p.x[i] - p.x[j]).squaredNorm(), pairRadius(p.radius[i], p.radius[j]));
     }
-    r += scene.model.water.restDensity * boundaryFraction(parts, p.x[i], p.radius[i], nullptr);
+    r += scene.model.water.restDensity * boundaryFraction(parts, p.x[i], WallKernel(p.radius[i]), nullptr);
     rho[i] = r;
   }
   return rho;
@@ -254,9 +254,9 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
   // the XSPH pass against a double-precision pair loop of Macklin 2013 Eq. 17 with soak's volume
   // weights 2 m_j / (rho_i + rho_j), equal radii, every other one shrunk, and one shrunk (its
   // neighbours take the per-pair radius, the others the constant one); scalar: 16-lane gathers were slower.
-  // Cases 3 and 4: the solver marked lists where one particle was shrunk, then another one is shrunk
-  // instead and the lists are built again (3: in the same object, 4: in a fresh one): the velocity pass
-  // must mark them again, not take the solver's flags
+  // Cases 0 - 2 take the flags solveFluid marked on the same lists. Cases 3 and 4: the solver marked
+  // lists where one particle was shrunk, then another one is shrunk instead and the lists are built
+  // again (3: in the same object, 4: in a fresh one): told so, the velocity pass marks them again
   for (const int mixed : {0, 1, 2, 3, 4}) {
     Scene scene = squeezedWaterOnCloth("0");
     const Model& model = scene.model;
@@ -283,7 +283,7 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
       buildNeighborLists(p.xPred, p.radius, grid, lists, static_cast<uint32_t>(nc));
     }
     const std::vector<Vec3> v0 = p.v;
-    fluidVelocityPass(model, p, lists, s, 0.015f);
+    fluidVelocityPass(model, p, lists, s, 0.015f, mixed < 3);  // 3, 4: not the lists solveFluid marked
     float worst = 0.0f, largest = 0.0f;
     for (size_t i = nc; i < p.size(); ++i) {
       Eigen::Vector3d b = Eigen::Vector3d::Zero();
@@ -340,7 +340,8 @@ TEST(Fluid, BoundaryPartBoxesSkipOnlyPartsBeyondTheSupport) {
   for (int k = 0; k < 20000; ++k) {
     const Vec3 x(1.4f * uniform() - 0.7f, 1.2f * uniform() - 0.8f, 1.0f * uniform() - 0.4f);
     Vec3 g, gRef;
-    const float phi = boundaryFraction(parts, x, h, &g), phiRef = boundaryFraction(unbounded, x, h, &gRef);
+    const float phi = boundaryFraction(parts, x, WallKernel(h), &g),
+                phiRef = boundaryFraction(unbounded, x, WallKernel(h), &gRef);
     EXPECT_EQ(phi, phiRef) << x.transpose();
     EXPECT_EQ(g, gRef) << x.transpose();
     near += phiRef > 0.0f;
