@@ -26,6 +26,56 @@ inline void parallelForDynamic(int64_t n, int64_t chunk, F&& body) {
   for (int64_t i = 0; i < n; ++i) body(i);
 }
 
+// Ordered chunks: items cut into chunks whose results vary in length (neighbour lists, contacts).
+// The chunks go to whichever thread is free (dynamic schedule), each filling its own buffer; the
+// buffers are then read in chunk order, so the result does not depend on the thread count.
+//   local(): the per-thread state of the fill (caches, marks), made once per thread
+//   fill(local, c, buffer): appends chunk c's results to its (cleared) buffer
+// fillChunks stops there (the caller joins the buffers). orderedChunks goes on: offset[c] becomes
+// the place of chunk c's first result when the buffers follow each other from `base`
+// (offset[chunks] is the end), then size(offset) runs once and place(c) runs for every chunk, in
+// parallel, to copy chunk c into its place. buffers and offset are kept by the caller's scratch.
+template <class T, class Local, class Fill>
+inline void fillChunksOnThisTeam(int64_t chunks, std::vector<std::vector<T>>& buffers, Local&& local, Fill&& fill) {
+  auto state = local();
+#pragma omp for schedule(dynamic, 1)
+  for (int64_t c = 0; c < chunks; ++c) {
+    // the buffer held here while it grows: the buffers' vector headers share cache lines, and each
+    // insert into a header in the shared array would take the line from the other cores
+    std::vector<T> out = std::move(buffers[static_cast<size_t>(c)]);
+    out.clear();
+    fill(state, c, out);
+    buffers[static_cast<size_t>(c)] = std::move(out);
+  }
+}
+
+template <class T, class Local, class Fill>
+inline void fillChunks(int64_t chunks, std::vector<std::vector<T>>& buffers, int threads, Local&& local, Fill&& fill) {
+  if (buffers.size() < static_cast<size_t>(chunks)) buffers.resize(static_cast<size_t>(chunks));
+#pragma omp parallel num_threads(threads)
+  fillChunksOnThisTeam(chunks, buffers, local, fill);
+}
+
+template <class T, class Local, class Fill, class Size, class Place>
+inline void orderedChunks(int64_t chunks, std::vector<std::vector<T>>& buffers, std::vector<size_t>& offset,
+                          size_t base, bool parallel, Local&& local, Fill&& fill, Size&& size, Place&& place) {
+  if (buffers.size() < static_cast<size_t>(chunks)) buffers.resize(static_cast<size_t>(chunks));
+  offset.resize(static_cast<size_t>(chunks) + 1);
+#pragma omp parallel if (parallel)
+  {
+    fillChunksOnThisTeam(chunks, buffers, local, fill);
+#pragma omp single
+    {
+      offset[0] = base;
+      for (int64_t c = 0; c < chunks; ++c)
+        offset[static_cast<size_t>(c) + 1] = offset[static_cast<size_t>(c)] + buffers[static_cast<size_t>(c)].size();
+      size(offset);
+    }
+#pragma omp for schedule(static)
+    for (int64_t c = 0; c < chunks; ++c) place(c);
+  }
+}
+
 // a half-open range [begin, end) of particle indices
 struct IndexRange {
   int64_t begin = 0, end = 0;

@@ -88,7 +88,7 @@ struct RangeCache {
 // the dense grid of buildNeighborLists: false (and nothing built) when the bounding box of x has
 // more than 8 cells a particle plus 2^20 cells (4 MiB of starts), or no particles. The 2^20 keep a
 // scene's domain dense once spray reaches its walls (Fig. 3(a): 75 x 56 x 75 cells for 25.6k
-// particles, 0.2 ms to sort; the hashed buckets took twice as long as the whole dense search)
+// particles), where the hashed buckets are slower than the whole dense search
 bool buildDenseCells(const std::vector<Vec3>& x, float cs, NeighborLists& lists) {
   const size_t n = x.size();
   if (n == 0 || !(cs > 0.0f)) return false;
@@ -277,14 +277,13 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   // cloth ones to cl[nCloth ..) and water ones to wa[nWater ..), in candidate order. Candidates with
   // a radius above `cutoff` are skipped. Branch free: every candidate is written, the cursor advances
   // only for neighbours (AVX-512: all of them to wa first, one store a vector, and the cloth ones
-  // moved to cl afterwards when there are any: 4 - 5 % off the list build of Fig. 5(c), 14 % of Fig.
-  // 9(b)'s under water, docs/performance.md session 13)
+  // moved to cl afterwards when there are any)
   const auto scan = [&](size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
                         std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) {
     const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
     uint32_t ncl = nCloth, nwa = nWater;
-    // locals, not the closure's references: the vector stores below may alias anything, and GCC would
-    // load every pointer again after each of them
+    // locals, not the closure's references: the vector stores below may alias anything, and the
+    // compiler would load every pointer again after each of them
     const float* const PX = px;
     const float* const PY = py;
     const float* const PZ = pz;
@@ -316,7 +315,7 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
                              _mm512_cmp_ps_mask(hj, vcut, _CMP_LE_OQ) & _mm512_cmpneq_epi32_mask(j, self);
         anyCloth |= in & _mm512_cmplt_epu32_mask(j, split);
         // compress in a register and store all 16 lanes (the list has room): a compressing store
-        // to memory is microcoded and slow on AMD Zen 4
+        // to memory is microcoded on some processors
         _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(in, j));
         nwa += static_cast<uint32_t>(__builtin_popcount(in));
       }
@@ -474,54 +473,47 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
   constexpr size_t kChunk = 256, kRound = 64;
   uint32_t* start = lists.start.data();
   uint32_t* mid = lists.mid.data();
-  lists.chunkBuffers.resize(kRound);
-  std::vector<size_t> offset(kRound + 1, 0);
+  std::vector<size_t>& offset = lists.chunkOffset;
+  struct Local {
+    RangeCache cache;
+    std::vector<uint32_t> cl = std::vector<uint32_t>(256), wa = std::vector<uint32_t>(256);
+  };
   for (size_t r0 = 0; r0 < n; r0 += kChunk * kRound) {
     const int64_t chunks = static_cast<int64_t>(std::min(kRound, (n - r0 + kChunk - 1) / kChunk));
-#pragma omp parallel if (parallel)
-    {
-      RangeCache cache;
-      std::vector<uint32_t> cl(256), wa(256);
-#pragma omp for schedule(dynamic, 1)
-      for (int64_t c = 0; c < chunks; ++c) {
-        // the chunk's buffer held here while it grows: the buffers' vector headers share cache lines,
-        // and each insert to a header in the shared array took the line from the other core
-        std::vector<uint32_t> out = std::move(lists.chunkBuffers[static_cast<size_t>(c)]);
-        out.clear();
-        const size_t lo = r0 + static_cast<size_t>(c) * kChunk, hi = std::min(n, lo + kChunk);
-        for (size_t i = lo; i < hi; ++i) {
-          uint32_t ncl, nwa;
-          gather(i, cache, cl, wa, ncl, nwa);
-          start[i + 1] = ncl + nwa;  // a count until the offsets are known
-          mid[i] = ncl;
-          out.insert(out.end(), cl.data(), cl.data() + ncl);
-          out.insert(out.end(), wa.data(), wa.data() + nwa);
-        }
-        lists.chunkBuffers[static_cast<size_t>(c)] = std::move(out);
+    const auto chunkRange = [&](int64_t c, size_t& lo, size_t& hi) {
+      lo = r0 + static_cast<size_t>(c) * kChunk;
+      hi = std::min(n, lo + kChunk);
+    };
+    const auto fill = [&](Local& t, int64_t c, std::vector<uint32_t>& out) {
+      size_t lo, hi;
+      chunkRange(c, lo, hi);
+      for (size_t i = lo; i < hi; ++i) {
+        uint32_t ncl, nwa;
+        gather(i, t.cache, t.cl, t.wa, ncl, nwa);
+        start[i + 1] = ncl + nwa;  // a count until the offsets are known
+        mid[i] = ncl;
+        out.insert(out.end(), t.cl.data(), t.cl.data() + ncl);
+        out.insert(out.end(), t.wa.data(), t.wa.data() + nwa);
       }
-#pragma omp single
-      {
-        offset[0] = start[r0];
-        for (int64_t c = 0; c < chunks; ++c)
-          offset[static_cast<size_t>(c) + 1] = offset[static_cast<size_t>(c)] + lists.chunkBuffers[static_cast<size_t>(c)].size();
-        const size_t total = offset[static_cast<size_t>(chunks)];
-        if (total > lists.index.capacity()) lists.index.reserve(total + total / 4);  // neighbours grew
-        lists.index.resize(total);
+    };
+    const auto size = [&](const std::vector<size_t>& off) {
+      const size_t total = off[static_cast<size_t>(chunks)];
+      if (total > lists.index.capacity()) lists.index.reserve(total + total / 4);  // neighbours grew
+      lists.index.resize(total);
+    };
+    const auto place = [&](int64_t c) {
+      const std::vector<uint32_t>& out = lists.chunkBuffers[static_cast<size_t>(c)];
+      std::copy(out.begin(), out.end(), lists.index.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(c)]));
+      size_t sum = offset[static_cast<size_t>(c)], lo, hi;
+      chunkRange(c, lo, hi);
+      for (size_t i = lo; i < hi; ++i) {
+        const uint32_t count = start[i + 1];
+        mid[i] = static_cast<uint32_t>(sum) + mid[i];
+        sum += count;
+        start[i + 1] = static_cast<uint32_t>(sum);
       }
-#pragma omp for schedule(static)
-      for (int64_t c = 0; c < chunks; ++c) {
-        const std::vector<uint32_t>& out = lists.chunkBuffers[static_cast<size_t>(c)];
-        std::copy(out.begin(), out.end(), lists.index.begin() + static_cast<std::ptrdiff_t>(offset[static_cast<size_t>(c)]));
-        size_t sum = offset[static_cast<size_t>(c)];
-        const size_t lo = r0 + static_cast<size_t>(c) * kChunk, hi = std::min(n, lo + kChunk);
-        for (size_t i = lo; i < hi; ++i) {
-          const uint32_t count = start[i + 1];
-          mid[i] = static_cast<uint32_t>(sum) + mid[i];
-          sum += count;
-          start[i + 1] = static_cast<uint32_t>(sum);
-        }
-      }
-    }
+    };
+    orderedChunks(chunks, lists.chunkBuffers, offset, start[r0], parallel, [] { return Local(); }, fill, size, place);
   }
 }
 

@@ -99,6 +99,7 @@ struct NeighborLists {
   uint32_t firstWater = 0;              // the index split the lists were built with
   std::vector<float> px, py, pz, ph;   // scratch of the build: candidates' positions and radii in cellEntries order
   std::vector<std::vector<uint32_t>> chunkBuffers;  // scratch of the build: the lists of one round's chunks
+  std::vector<size_t> chunkOffset;                  // scratch of the build: where each chunk's lists go
   // scratch of the build: a dense grid of the particles' bounding box (buildNeighborLists); dense
   // tells whether the last build used it or the hashed grid's buckets
   bool dense = false;

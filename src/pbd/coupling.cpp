@@ -46,7 +46,7 @@ Vec3 closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3&
 }
 
 #if defined(__AVX512F__)
-// min and max by compare and blend (GCC 12 warns about _mm512_min_ps / _mm512_max_ps's undefined operand)
+// min and max by compare and blend (_mm512_min_ps / _mm512_max_ps draw a false undefined-operand warning)
 inline __m512 minPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp_ps_mask(y, x, _CMP_LT_OQ), x, y); }
 inline __m512 maxPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp_ps_mask(x, y, _CMP_LT_OQ), x, y); }
 #endif
@@ -173,7 +173,7 @@ float overFaceDistance(const Model& model, const Particles& p, const CouplingScr
 template <class Take>
 void walkNearPath(const ClothBoxGrid& grid, const Vec3& a, const Vec3& ab, float reachQ, float reach, Take&& take) {
   const Vec3 lo = grid.origin, hi = grid.origin + grid.dims.cast<float>() * grid.cell;
-  // locals: take() writes memory, after which GCC would load the grid's pointers again
+  // locals: take() writes memory, after which the compiler would load the grid's pointers again
   const float* const PX = grid.px.data();
   const float* const PY = grid.py.data();
   const float* const PZ = grid.pz.data();
@@ -298,69 +298,60 @@ void findCouplingCandidates(const Model& model, const Particles& p, CouplingScra
   s.seen.resize(static_cast<size_t>(nThreads));
   s.seenCloth.resize(static_cast<size_t>(nThreads));
   const int64_t chunks = (nw + kWaterChunk - 1) / kWaterChunk;
-  s.chunkCandidates.resize(static_cast<size_t>(chunks));
-  std::vector<size_t> offset(static_cast<size_t>(chunks) + 1, 0);
   s.triangleActive.assign(nTri, 0);
   uint8_t* const active = s.triangleActive.data();
   // chunks of water particles go to whichever thread is free (the water near the sheet is not spread
   // evenly over the indices); each chunk fills its own list and the lists are joined in water order,
   // so the candidates do not depend on the thread count
-#pragma omp parallel num_threads(nThreads)
-  {
-    const int t = omp_get_thread_num();
-    std::vector<uint32_t>& seen = s.seen[static_cast<size_t>(t)];
-    std::vector<uint32_t>& seenCloth = s.seenCloth[static_cast<size_t>(t)];
-    seen.assign(nTri, ~0u);
-    seenCloth.assign(static_cast<size_t>(nc), ~0u);
-#pragma omp for schedule(dynamic, 1)
-    for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-      // the chunk's list held here while it grows: the chunks' vector headers share cache lines, and
-      // each push_back to a header in the shared array took the line from the other core
-      std::vector<uint32_t> out = std::move(s.chunkCandidates[static_cast<size_t>(chunk)]);
-      out.clear();
-      const int64_t begin = chunk * kWaterChunk, end = std::min(nw, begin + kWaterChunk);
-      for (int64_t w = begin; w < end; ++w) {
-        const int64_t q = nc + w;
-        const Vec3 a = p.x[q], ab = p.xPred[q] - a;
-        const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
-        float nearest2 = std::numeric_limits<float>::max();
-        int32_t nearest = -1;
-        // cloth particle j lies within reach of the path: its triangles are candidates
-        const auto take = [&](uint32_t j) {
-          if (seenCloth[j] == static_cast<uint32_t>(q)) return;
-          seenCloth[j] = static_cast<uint32_t>(q);
-          const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
-          if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
-          for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
-            const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
-            if (seen[tri] == static_cast<uint32_t>(q)) continue;
-            seen[tri] = static_cast<uint32_t>(q);
-            if (s.startNormal[tri].isZero()) continue;  // a degenerate triangle has no side
-            out.push_back(tri);
-            __atomic_store_n(active + tri, uint8_t{1}, __ATOMIC_RELAXED);  // both threads may mark it
-          }
-        };
-        walkNearPath(grid, a, ab, reachQ, reach, take);
-        s.nearestCloth[static_cast<size_t>(w)] = nearest;
-        s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
-      }
-      s.chunkCandidates[static_cast<size_t>(chunk)] = std::move(out);
+  struct Marks {
+    std::vector<uint32_t>& seen;       // the water particle that last took each triangle
+    std::vector<uint32_t>& seenCloth;  // the water particle that last took each cloth particle
+  };
+  const auto marks = [&] {
+    const size_t t = static_cast<size_t>(omp_get_thread_num());
+    s.seen[t].assign(nTri, ~0u);
+    s.seenCloth[t].assign(static_cast<size_t>(nc), ~0u);
+    return Marks{s.seen[t], s.seenCloth[t]};
+  };
+  const auto fill = [&](Marks& m, int64_t chunk, std::vector<uint32_t>& out) {
+    std::vector<uint32_t>& seen = m.seen;
+    std::vector<uint32_t>& seenCloth = m.seenCloth;
+    const int64_t begin = chunk * kWaterChunk, end = std::min(nw, begin + kWaterChunk);
+    for (int64_t w = begin; w < end; ++w) {
+      const int64_t q = nc + w;
+      const Vec3 a = p.x[q], ab = p.xPred[q] - a;
+      const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
+      float nearest2 = std::numeric_limits<float>::max();
+      int32_t nearest = -1;
+      // cloth particle j lies within reach of the path: its triangles are candidates
+      const auto take = [&](uint32_t j) {
+        if (seenCloth[j] == static_cast<uint32_t>(q)) return;
+        seenCloth[j] = static_cast<uint32_t>(q);
+        const float d2 = (a - p.x[j]).squaredNorm();  // the sheet side is judged at the start
+        if (d2 < nearest2 || (d2 == nearest2 && static_cast<int32_t>(j) < nearest)) nearest2 = d2, nearest = static_cast<int32_t>(j);
+        for (int f = model.vertexTriangleStart[j]; f < model.vertexTriangleStart[j + 1]; ++f) {
+          const uint32_t tri = static_cast<uint32_t>(model.vertexTriangles[f]);
+          if (seen[tri] == static_cast<uint32_t>(q)) continue;
+          seen[tri] = static_cast<uint32_t>(q);
+          if (s.startNormal[tri].isZero()) continue;  // a degenerate triangle has no side
+          out.push_back(tri);
+          __atomic_store_n(active + tri, uint8_t{1}, __ATOMIC_RELAXED);  // both threads may mark it
+        }
+      };
+      walkNearPath(grid, a, ab, reachQ, reach, take);
+      s.nearestCloth[static_cast<size_t>(w)] = nearest;
+      s.candidateStart[static_cast<size_t>(w) + 1] = static_cast<uint32_t>(out.size());  // local until shifted
     }
-#pragma omp single
-    {
-      for (int64_t c = 0; c < chunks; ++c)
-        offset[static_cast<size_t>(c) + 1] = offset[static_cast<size_t>(c)] + s.chunkCandidates[static_cast<size_t>(c)].size();
-      s.candidates.resize(offset[static_cast<size_t>(chunks)]);
-    }
-#pragma omp for schedule(static)
-    for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-      const std::vector<uint32_t>& out = s.chunkCandidates[static_cast<size_t>(chunk)];
-      const size_t at = offset[static_cast<size_t>(chunk)];
-      std::copy(out.begin(), out.end(), s.candidates.begin() + static_cast<std::ptrdiff_t>(at));
-      for (int64_t w = chunk * kWaterChunk, end = std::min(nw, w + kWaterChunk); w < end; ++w)
-        s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(at);
-    }
-  }
+  };
+  const auto size = [&](const std::vector<size_t>& offset) { s.candidates.resize(offset[static_cast<size_t>(chunks)]); };
+  const auto place = [&](int64_t chunk) {
+    const std::vector<uint32_t>& out = s.chunkCandidates[static_cast<size_t>(chunk)];
+    const size_t at = s.chunkOffset[static_cast<size_t>(chunk)];
+    std::copy(out.begin(), out.end(), s.candidates.begin() + static_cast<std::ptrdiff_t>(at));
+    for (int64_t w = chunk * kWaterChunk, end = std::min(nw, w + kWaterChunk); w < end; ++w)
+      s.candidateStart[static_cast<size_t>(w) + 1] += static_cast<uint32_t>(at);
+  };
+  orderedChunks(chunks, s.chunkCandidates, s.chunkOffset, 0, true, marks, fill, size, place);
   // the triangles some particle has as a candidate (marked as they were found): the passes need the
   // planes of these only (in Fig. 1 the 2.5k water particles near a 28k-triangle sheet have a few thousand)
   s.activeTriangles.clear();
@@ -472,7 +463,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
   const int nThreads = omp_get_max_threads();
   const size_t nTri = model.triangles.size();
   const int64_t nw = n - nc, chunks = (nw + kWaterChunk - 1) / kWaterChunk;
-  s.chunkContacts.resize(static_cast<size_t>(chunks));
+  s.chunkContacts.resize(static_cast<size_t>(chunks));  // exactly: the sums below read every chunk's list
   s.researchMark.resize(static_cast<size_t>(nThreads));
   s.researchCount.resize(static_cast<size_t>(nThreads), 0u);
   if (s.triangleStiffness.size() != nTri) s.triangleStiffness.assign(nTri, 1.0f);
@@ -497,10 +488,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
 
   // chunks of water particles go to whichever thread is free; each chunk records its contacts in its
   // own list, and the lists are summed in water order below, for any thread count
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nThreads)
-  for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-    std::vector<CouplingContact> out = std::move(s.chunkContacts[static_cast<size_t>(chunk)]);  // held here: see findCouplingCandidates
-    out.clear();
+  fillChunks(chunks, s.chunkContacts, nThreads, [] { return 0; }, [&](int, int64_t chunk, std::vector<CouplingContact>& out) {
     const int64_t begin = nc + chunk * kWaterChunk, end = std::min(n, begin + kWaterChunk);
     for (int64_t q = begin; q < end; ++q) {
       const uint32_t c0 = s.candidateStart[static_cast<size_t>(q - nc)], c1 = s.candidateStart[static_cast<size_t>(q - nc) + 1];
@@ -593,8 +581,7 @@ uint64_t solveCoupling(const Model& model, Particles& p, CouplingScratch& s, boo
       }
       p.xPred[q] += dq;  // q's own correction: only this thread writes q
     }
-    s.chunkContacts[static_cast<size_t>(chunk)] = std::move(out);
-  }
+  });
   // cloth corrections summed in water order, averaged per vertex (Jacobi)
   uint64_t contacts = 0;
   for (const auto& list : s.chunkContacts) contacts += list.size();

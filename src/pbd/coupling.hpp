@@ -62,6 +62,7 @@ struct CouplingScratch {
   std::vector<float> vertexReach;            // m, per cloth particle: how near a path it is a candidate
   std::vector<int32_t> nearestCloth;         // per water particle: the cloth particle nearest its start (-1: none)
   std::vector<std::vector<uint32_t>> chunkCandidates;  // candidates of each chunk of water particles
+  std::vector<size_t> chunkOffset;                     // where each chunk's candidates go
   std::vector<uint32_t> candidateStart;      // CSR over water particles (index - numCloth): their candidate
   std::vector<uint32_t> candidates;          // triangles, found once per substep for every coupling pass
   std::vector<float> candidateSide;          // +-1: the side of each candidate the particle came from
