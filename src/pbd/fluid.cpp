@@ -110,7 +110,7 @@ bool commonRadius(const std::vector<float>& radius, float& h) {
 //   constant h0 (the same values: (h0 + h0) / 2 = h0).
 // - plain (null: not wanted): a water particle of water.particleMass m0 and radius h0 whose neighbours
 //   all are ("plain": most of a pool). Its density pass takes m_j = m0 and w_j = 1 / m0 as constants
-//   instead of gathering them, the same numbers (docs/performance.md, session 11). A cloth neighbour
+//   instead of gathering them, the same numbers. A cloth neighbour
 //   (Psi_b, its own w), a drip or a partly absorbed particle makes its neighbours not plain.
 void markNeighbourhoods(const Particles& p, const NeighborLists& nb, int64_t nc, float m0, float h0,
                         std::vector<uint8_t>* mixed, std::vector<uint8_t>* plain) {
@@ -176,8 +176,8 @@ struct PairInputs {
 // same order, no FMA), and the sums are kept per lane and added across lanes at the end. Lanes past
 // the list's end have mass 0 and masked kernels: they add 0. Lists shorter than kSimdMinPairs (spray)
 // take the scalar loop, which is then faster. The order of the sums depends on the list's length,
-// never on the thread count; results differ from a build without AVX-512 in the last bits. Hand-written: GCC 12
-// vectorised these loops with scalar loads in place of gathers, slower than scalar (docs/performance.md).
+// never on the thread count; results differ from a build without AVX-512 in the last bits. Written by
+// hand: the compiler's own vectorisation of these loops loads the gathered values one by one.
 constexpr uint32_t kSimdMinPairs = 4;
 namespace v16 {
 inline __m512 set(float x) { return _mm512_set1_ps(x); }
@@ -196,8 +196,7 @@ struct Pairs {
 };
 // x, y, z of the 16 particles idx[0 .. 16) from 3-float records: one 128-bit load a particle (its
 // fourth float masked off, so the last record reads nothing past the array) and a 4 x 4 transpose in
-// each 128-bit quarter. On AMD Zen 4 three gathers cost about 1.5x as much (docs/performance.md,
-// session 12); the values are the same
+// each 128-bit quarter, cheaper than three gathers; the values are the same
 inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& y, __m512& z) {
   const auto at = [&](int l) { return _mm_maskz_loadu_ps(__mmask8(0x7), X + 3 * static_cast<size_t>(idx[l])); };
   __m512 a = _mm512_castps128_ps512(at(0)), b = _mm512_castps128_ps512(at(1));
@@ -219,7 +218,7 @@ inline void positionsOf(const float* X, const uint32_t* idx, __m512& x, __m512& 
 }
 // positionsOf the lanes' neighbours index[k ..), lanes m: past the list's end the lanes read the next
 // lists' neighbours (valid particles, masked by the callers); at the end of the index array they read
-// particle 0. A copy of the lanes would be slower: its scalar loads wait for the vector store
+// particle 0. (Not a copy of the lanes: its scalar loads would wait for the vector store)
 inline void neighbourPositions(const PairInputs& in, uint32_t k, __mmask16 m, __m512i j, __m512& x, __m512& y, __m512& z) {
   if (k + 16 <= in.indexSize) return positionsOf(in.X, in.index + k, x, y, z);
   alignas(64) uint32_t copy[16];
@@ -276,7 +275,7 @@ inline __m512 sCorr(const PairInputs& in, const Kernel& kern, __m512 r2, __mmask
   return _mm512_maskz_mul_ps(water, set(in.sCorrK), mul(set(-1.0f), power));
 }
 // the lanes' sum as a fixed tree (halves, quarters, pairs). The maskz forms here and in spikyFactor
-// (all lanes): GCC 12's headers draw -Wmaybe-uninitialized from the plain ones
+// (all lanes): the plain ones draw a false -Wmaybe-uninitialized warning
 inline float sum(__m512 a) {
   constexpr __mmask16 all = 0xFFFF;
   a = add(a, _mm512_maskz_shuffle_f32x4(all, a, a, 0x4E));
@@ -512,8 +511,8 @@ inline int reactionSum(const PairInputs& in, size_t b, uint32_t k0, uint32_t k1,
 
 }  // namespace
 
-// water particles a chunk of the solver's dynamically scheduled passes: against static halves a few
-// per cent faster (Figs. 5(c), 9(b), docs/performance.md session 12); chunks of 256 were slower
+// water particles a chunk of the solver's dynamically scheduled passes (the water by the cloth, the
+// smaller particles and the surface cost more a particle than the pool's: static halves are unequal)
 constexpr int64_t kWaterPassChunk = 1024;
 
 // The solver's neighbour loops are densitySums, correctionSum and reactionSum above (AVX-512 by hand
@@ -575,8 +574,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (int it = 0; it < iterations; ++it) {
       // lambda of each water particle from the density constraint C_i = rho_i / rho0 - 1 (Eq. 6-7).
-      // Chunks of kWaterPassChunk to whichever thread is free: the water by the cloth, the smaller
-      // particles and the surface cost more a particle than the pool's (docs/performance.md, session 12)
+      // Chunks of kWaterPassChunk to whichever thread is free
       parallelForDynamic(nw, kWaterPassChunk, [&](int64_t w) {
         const size_t i = static_cast<size_t>(nc + w);
         const float hi = H[i], mi = p.mass[i];

@@ -75,7 +75,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
       const float* const L = lap + begin;
       const float* const C = cosG + begin;
       float* const W = s.pairFloat.get(count);
-      const float rho0 = restDensity(i), kdL = kd, etaL = eta;  // locals: GCC does not vectorise
+      const float rho0 = restDensity(i), kdL = kd, etaL = eta;  // locals: the compiler does not vectorise
 #pragma omp simd                                                  // loads through the closure
       for (uint32_t k = 0; k < count; ++k) W[k] = (kdL * L[k] / rho0) * (1.0f + etaL * std::fabs(C[k]));
       float a = 0.0f, sq = 0.0f;
@@ -99,7 +99,7 @@ void diffuseWater(const Model& model, State& state, const NeighborLists& nb, Wet
       const float* const L = lap + begin;
       const float* const C = cosG + begin;
       double* const T = s.pairDouble.get(count);
-      // locals: GCC does not vectorise loads through the closure
+      // locals: the compiler does not vectorise loads through the closure
       const int32_t* const P = phase;
       const float* const SL = S;
       const float* const SG = sigma;

@@ -148,7 +148,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   // doubles, selects, the arithmetic of the scalar expressions) into a per-thread buffer and sums them
   // in list order, so every result is that of the scalar loop. A pair the scalar loop skipped
   // contributes a zero, which leaves a sum started at +0 unchanged. Pointers are copied into the
-  // loops' own locals: GCC does not vectorise loads through a lambda's captures.
+  // loops' own locals: the compiler does not vectorise loads through a lambda's captures.
   const uint32_t* const indexAll = nb.index.data();
   const int32_t* const phaseAll = p.phase.data();
   const float* const xAll = p.x[0].data();
@@ -185,7 +185,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
       // (V_j S_j cos) spikyGrad(x_i - x_j, h_ij), spikyGrad = f (x_i - x_j)
       const float q = VL[jj] * SL[jj] * cosIJ, f = F[k];
       const float dx = xi - X[3 * j], dy = yi - X[3 * j + 1], dz = zi - X[3 * j + 2];
-      // times 1 or 0, not a select: GCC would make the gathers masked, which it cannot emulate
+      // times 1 or 0, not a select: the compiler would make the gathers masked, which it cannot emulate
       const float m = above ? 1.0f : 0.0f;
       Tx[k] = q * (f * dx) * m;
       Ty[k] = q * (f * dy) * m;

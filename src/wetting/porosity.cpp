@@ -112,7 +112,7 @@ void pairGeometryThen(const Model& model, const Particles& p, const NeighborList
   float* const coss = s.pairCos.data();
   float* const spikys = s.pairSpiky.data();
   parallelFor(nc, [&](int64_t i) {
-    // local copies: GCC does not vectorise loads through the closure's references
+    // local copies: the compiler does not vectorise loads through the closure's references
     const float* const X = x;
     const float* const H = radius;
     const uint32_t* const index = list;

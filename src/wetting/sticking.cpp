@@ -25,9 +25,9 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
   const std::vector<float>& sat = state.clothSaturation;
   s.force.resize(static_cast<size_t>(nc));
   // gathered per particle; the pair's force is bit for bit opposite seen from the other side. The
-  // pairs' terms in a vectorised loop (plain floats, selects: stickingCoefficient, poly6 and the tests
-  // below with the same arithmetic) into a per-thread buffer, summed in list order: the scalar loop's
-  // result (a skipped pair adds +0). Pointers copied to locals: GCC does not vectorise through captures
+  // pairs' terms in a vectorised loop (plain floats and selects; it calls stickingCoefficient and
+  // poly6Coef) into a per-thread buffer, summed in list order: the scalar loop's result (a skipped pair
+  // adds +0). Pointers copied to locals: the compiler does not vectorise through captures
   const float* const xAll = p.x[0].data();
   const float* const restAll = model.clothRestPosition[0].data();
   const float* const radiusAll = p.radius.data();

@@ -1,5 +1,5 @@
 // cloth wetting of Shao, Wu, Wang 2017 section 4: cloth particles are porous and hold water. One
-// model per file, each a stage of the wetting pass after a step's last substep (src/pbd/step.cpp;
+// model per file, each a stage of the wetting pass after a step's last substep (src/sim/step.cpp;
 // wetting.everySubstep: after every substep), in the order of Algorithm 1:
 //   permeability.cpp  Eq. 22   coupling stiffness from saturation (before the coupling, every substep)
 //   porosity.cpp      Eq. 10   particle volume, saturation, wet mass

@@ -61,7 +61,7 @@ struct PreparedMesh {
   std::vector<Vec3d> vertexNormal;             // angle-weighted sum of the faces around
 };
 
-// fmt, not "(" + std::to_string(a) + ...: GCC 12 warned (-Wrestrict, a false positive) on the inlined string concatenation
+// "(a, b)" (fmt: the inlined string concatenation draws a false -Wrestrict warning)
 std::string edgeText(int a, int b) { return fmt::format("({}, {})", a, b); }
 
 PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
