@@ -4,11 +4,10 @@
 #include "progress.hpp"
 
 #include <soak/error.hpp>
+#include <soak/output.hpp>
 #include <soak/scene.hpp>
 #include <soak/step.hpp>
-
-#include "core/parallel.hpp"
-#include "io/file.hpp"
+#include <soak/threads.hpp>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>

@@ -1,6 +1,6 @@
 // the subcommands of the soak program; each returns the process exit code
 #pragma once
-#include "render/render.hpp"
+#include <soak/render.hpp>
 
 #include <string>
 #include <vector>

@@ -1,6 +1,5 @@
 // `soak render` and `soak surface`: options, a progress bar and a summary around src/render/
-#include "render/render.hpp"
-#include "render/run_output.hpp"
+#include <soak/render.hpp>
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -114,7 +113,7 @@ int renderCommand(RenderCliOptions& o) {
   r.camera.position = parsePoint(o.camera);
   r.camera.lookAt = parsePoint(o.lookAt);
   {  // the scene's "view" fills what the command line left out
-    const ViewSettings view = openRunOutput(r.runDir).scene.view;
+    const ViewSettings view = runView(r.runDir);
     const auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
     if (!r.camera.position && view.camera) r.camera.position = view.camera;
     if (!r.camera.lookAt && view.lookAt) r.camera.lookAt = view.lookAt;

@@ -2,18 +2,12 @@
 #include "commands.hpp"
 
 #include <soak/error.hpp>
+#include <soak/output.hpp>
 #include <soak/scene.hpp>
 #include <soak/step.hpp>
+#include <soak/threads.hpp>
 
-#include "core/parallel.hpp"
-#include "garment/stage.hpp"
-#include "io/file.hpp"
-#include "io/output.hpp"
-#include "io/stats.hpp"
 #include "progress.hpp"
-#include "scene/overrides.hpp"
-#include "wetting/wetting.hpp"
-#include "world/emitters.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -64,31 +58,6 @@ void prepareOutputDir(const std::string& dir, bool overwrite) {
   if (ec) throw Error(dir + ": cannot create the output directory: " + ec.message());
 }
 
-// relative file paths in the scene ("mesh": {"path": ...}) made absolute against the scene's folder,
-// so dir/scene.json runs from anywhere
-void resolvePaths(nlohmann::json& v, const fs::path& baseDir) {
-  if (v.is_object()) {
-    for (auto it = v.begin(); it != v.end(); ++it) {
-      if (it.key() == "path" && it->is_string()) {
-        const fs::path p = it->get<std::string>();
-        if (p.is_relative() && fs::exists(baseDir / p)) *it = fs::absolute(baseDir / p).lexically_normal().string();
-      } else {
-        resolvePaths(*it, baseDir);
-      }
-    }
-  } else if (v.is_array()) {
-    for (auto& e : v) resolvePaths(e, baseDir);
-  }
-}
-
-// the scene file as run: its JSON with the --set overrides applied and paths resolved
-void writeResolvedScene(const RunOptions& o, const std::string& path) {
-  nlohmann::json doc = parseSceneJson(readTextFile(o.scene), o.scene);
-  applyOverrides(doc, o.overrides, o.scene);
-  resolvePaths(doc, fs::absolute(o.scene).parent_path());
-  writeTextFile(path, doc.dump(2) + "\n");
-}
-
 nlohmann::ordered_json waterJson(const WaterMass& w, const State& s) {
   return {{"freeKg", w.free},
           {"heldInClothKg", w.heldInCloth},
@@ -106,23 +75,6 @@ std::string outputList(const Model& model, const OutputSettings& out) {
   if (model.numCloth > 0 && out.clothPly) s += "cloth_NNNN.ply, ";
   if (out.water) s += "water_NNNN.ply, ";
   return s + "stats.jsonl";
-}
-
-// water particles the block emitters will create (emitted on a copy, so the counts are the emitter's own)
-size_t blockParticles(const Model& m) {
-  Model blocks = m;
-  blocks.emitters.clear();
-  double first = 0.0, last = 0.0;
-  for (const Emitter& e : m.emitters) {
-    if (e.kind != EmitterKind::Block) continue;
-    first = blocks.emitters.empty() ? e.start : std::min(first, static_cast<double>(e.start));
-    last = blocks.emitters.empty() ? e.start : std::max(last, static_cast<double>(e.start));
-    blocks.emitters.push_back(e);
-  }
-  if (blocks.emitters.empty()) return 0;
-  State s;
-  s.emitters.resize(blocks.emitters.size());
-  return emitWater(blocks, s, first - 1.0, static_cast<float>(last - first + 2.0));
 }
 
 }  // namespace
@@ -160,7 +112,7 @@ int runCommand(const RunOptions& o) {
 
   prepareOutputDir(o.outDir, o.overwrite);
   const fs::path dir(o.outDir);
-  writeResolvedScene(o, (dir / "scene.json").string());
+  writeTextFile((dir / "scene.json").string(), sceneAsRun(o.scene, o.overrides));
   nlohmann::ordered_json run = {{"soak", kVersion},
                         {"threads", threadCount()},
                         {"commandLine", joinCommandLine(o.commandLine)},
@@ -200,18 +152,7 @@ int runCommand(const RunOptions& o) {
       }
       runMs += fs.ms;
       const std::string bad = checkState(model, state);
-      // a diverged frame is written too: it shows where the blow-up started
-      // the cloth's saturation (Eq. 10) as a PLY attribute and as the paper's colours in the OBJ
-      std::vector<Vec3> colors = saturationColors(model, state, out.colorRamp);
-      std::vector<PlyFloatAttribute> extras;
-      if (model.wetting.enabled) extras.push_back({"saturation", state.clothSaturation});
-      std::vector<float> wetness;  // Chen 2012 pieces without Shao's wetting: Q(t) / delta, same ramp
-      if (!model.wetting.enabled && !state.clothWetStart.empty()) {
-        wetness = clothWetness(model, state);
-        extras.push_back({"wetness", wetness});
-        colors = rampColors(wetness, 1.0f, out.colorRamp);
-      }
-      writeFrameFiles(dir.string(), model, state, out, frame, extras, colors);
+      writeFrame(dir.string(), model, state, out, frame);  // a diverged frame too: it shows where the blow-up started
       nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
       if (!bad.empty()) line["error"] = bad;
       stats.write(line);
@@ -277,7 +218,7 @@ int validateCommand(const ValidateOptions& o) {
   std::printf("%s: valid\n", o.scene.c_str());
   std::printf("  name:        %s\n", scene.name.c_str());
   std::printf("  particles:   %d cloth, %zu water at start, %zu water from blocks\n", m.numCloth, water,
-              blockParticles(m));
+              blockParticleCount(m));
   std::printf("  cloth:       %zu pieces, %zu triangles, %zu pinned particles\n", m.pieces.size(), m.triangles.size(),
               pinned);
   for (const ClothPiece& p : m.pieces)

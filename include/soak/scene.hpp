@@ -44,6 +44,14 @@ struct Scene {
 // expected.
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
 
+// the scene file's JSON text as a run uses it: the overrides applied and relative file paths made
+// absolute against the scene's folder, so it runs from anywhere (soak run's scene.json). Throws
+// soak::Error as loadScene does for an unreadable file or a bad override
+std::string sceneAsRun(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// the water particles the model's block emitters will create
+size_t blockParticleCount(const Model& model);
+
 // the same from JSON text; relative mesh paths resolve against baseDir
 Scene loadSceneFromString(const std::string& text, const std::string& sourceName, const std::string& baseDir,
                           const std::vector<std::string>& overrides = {});

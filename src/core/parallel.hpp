@@ -2,7 +2,9 @@
 // own index), so results do not depend on the thread count.
 #pragma once
 #include <omp.h>
+#include <soak/threads.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -109,9 +111,5 @@ class ThreadBuffers {
   std::vector<std::vector<T>> buffers_;
 };
 
-inline int threadCount() { return omp_get_max_threads(); }
-inline void setThreadCount(int n) {
-  if (n > 0) omp_set_num_threads(n);
-}
 
 }  // namespace soak

@@ -1,6 +1,7 @@
 // small file helpers for the writers: every failure throws soak::Error naming the file
 #pragma once
 #include <soak/error.hpp>
+#include <soak/output.hpp>
 
 #include <fstream>
 #include <string>
@@ -13,12 +14,6 @@ std::ofstream openForWrite(const std::string& path);
 
 // flushes and closes `out`; throws soak::Error naming `path` when any write failed
 void finishWrite(std::ofstream& out, const std::string& path);
-
-// writes `text` to `path` in one go
-void writeTextFile(const std::string& path, std::string_view text);
-
-// reads a whole file; throws soak::Error naming the file on failure
-std::string readTextFile(const std::string& path);
 
 // "prefix_NNNN.ext" with a 4-digit (or longer) zero-padded frame number
 std::string frameFileName(const std::string& prefix, int frame, const std::string& ext);

@@ -1,7 +1,9 @@
 #include "io/output.hpp"
 
+#include "garment/stage.hpp"
 #include "io/file.hpp"
 #include "io/obj.hpp"
+#include "wetting/wetting.hpp"
 
 #include <filesystem>
 
@@ -32,6 +34,21 @@ std::vector<std::string> writeFrameFiles(const std::string& dir, const Model& mo
     written.push_back(path);
   }
   return written;
+}
+
+std::vector<std::string> writeFrame(const std::string& dir, const Model& model, const State& state,
+                                    const OutputSettings& settings, int frame) {
+  // the cloth's saturation (Eq. 10) as a PLY attribute and as the paper's colours in the OBJ
+  std::vector<Vec3> colors = saturationColors(model, state, settings.colorRamp);
+  std::vector<PlyFloatAttribute> extras;
+  if (model.wetting.enabled) extras.push_back({"saturation", state.clothSaturation});
+  std::vector<float> wetness;  // Chen 2012 pieces without Shao's wetting: Q(t) / delta, same ramp
+  if (!model.wetting.enabled && !state.clothWetStart.empty()) {
+    wetness = clothWetness(model, state);
+    extras.push_back({"wetness", wetness});
+    colors = rampColors(wetness, 1.0f, settings.colorRamp);
+  }
+  return writeFrameFiles(dir, model, state, settings, frame, extras, colors);
 }
 
 }  // namespace soak

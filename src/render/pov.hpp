@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <soak/render.hpp>
+
 #include "render/run_output.hpp"
 #include "render/surface.hpp"
 #include "world/colliders.hpp"
@@ -24,21 +26,6 @@ struct Bounds {
 
 // world bounds of a collider at a pose; empty for a plane (infinite)
 Bounds colliderBounds(const Collider& c, const ColliderPose& pose);
-
-struct CameraSpec {
-  Vec3 position{0, 1, 3};
-  Vec3 lookAt{0, 0, 0};
-  float fovDegrees = 40.0f;  // horizontal
-};
-
-// what the user asked for; what is not given is chosen so that `bounds` fills the picture
-struct CameraRequest {
-  std::optional<Vec3> position, lookAt;
-  float fovDegrees = 40.0f;        // horizontal field of view
-  float azimuthDegrees = 35.0f;    // direction to the camera around y, from +z towards +x
-  float elevationDegrees = 25.0f;  // above the horizontal
-  float zoom = 1.0f;               // the automatic distance is divided by this
-};
 
 // automatic framing: collects points (and boxes) and places the camera to look at the centre of their
 // bounds (or the requested point) from the requested direction, at the smallest distance at which
@@ -64,8 +51,6 @@ class CameraFit {
 
 // the camera that shows every corner of `bounds` (CameraFit with the eight corners)
 CameraSpec frameCamera(const Bounds& bounds, const CameraRequest& request, int width, int height);
-
-enum class WaterStyle { Surface, Particles };
 
 struct PovFrameInput {
   const Model* model = nullptr;                  // colliders

@@ -1,5 +1,5 @@
 // rendering a run: frame bounds -> one camera -> a .pov per frame -> POV-Ray in parallel -> ffmpeg
-#include "render/render.hpp"
+#include <soak/render.hpp>
 
 #include <fmt/format.h>
 
@@ -12,6 +12,9 @@
 #include <thread>
 
 #include "io/file.hpp"
+#include "render/pov.hpp"
+#include "render/run_output.hpp"
+#include "render/surface.hpp"
 #include "render/process.hpp"
 #include "world/colliders.hpp"
 
@@ -305,5 +308,7 @@ RenderResult renderRun(const RenderOptions& o, const std::function<void(int, int
   if (!o.keepPov) fs::remove_all(job.workDir, ec);
   return res;
 }
+
+ViewSettings runView(const std::string& runDir) { return openRunOutput(runDir).scene.view; }
 
 }  // namespace soak

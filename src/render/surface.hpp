@@ -6,33 +6,12 @@
 #include <memory>
 #include <soak/math.hpp>
 #include <soak/model.hpp>
+#include <soak/render.hpp>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace soak {
-
-struct SurfaceSettings {
-  // voxel edge (m); 0: a sixth of the median support radius h (a third of the Table 1 spacing)
-  float voxelSize = 0.0f;
-  // ball radius of a particle as a fraction of its support radius h_i: h/2 is the spacing r0 at
-  // Table 1 values, so the balls of neighbours overlap and a block has no holes
-  float radiusFraction = 0.5f;
-  // distance the smoothed surface is moved inwards, as a fraction of the median h. The union of
-  // balls of radius r0 reaches r0 past the outer particles (less in the dimples between them); a
-  // lattice block's cells end r0/2 past them. 3/16 h was calibrated so resting blocks of 6^3 to
-  // 24^3 particles enclose their lattice volume to within 5% (tests/render/surface_test.cpp)
-  float erosionFraction = 0.1875f;
-  // a particle whose centre ends up outside the smoothed, eroded surface or less than a quarter of
-  // a drop radius inside it (a drip, a splash: the smoothing removes lone balls) is added back as a ball of
-  // this fraction of its h; 5/16 h is the
-  // radius of the sphere holding a Table 1 particle's volume (m / rho0)
-  float dropFraction = 0.3125f;
-  // Gaussian smoothing passes (width 1 voxel) of the level set before the erosion
-  int smoothingIterations = 1;
-  // narrow band half width in voxels
-  float halfWidth = 3.0f;
-};
 
 // a triangle mesh, outward facing: counter-clockwise seen from outside
 struct SurfaceMesh {

@@ -2,6 +2,8 @@
 // discs (Fig. 1) and rain over a rectangle (Chen 2012 Fig. 9). Serial: emission is cheap, and the order of new particles must be deterministic.
 #include "world/emitters.hpp"
 
+#include <soak/scene.hpp>
+
 #include "core/kernels.hpp"
 
 #include <algorithm>
@@ -198,6 +200,18 @@ size_t emitWater(const Model& model, State& state, double t, float dt) {
     }
   }
   return created;
+}
+
+size_t blockParticleCount(const Model& model) {
+  // emitBlock's lattice sites, at most solver.maxParticles in all
+  const float s = model.water.spacing;
+  size_t count = 0;
+  for (const Emitter& e : model.emitters)
+    if (e.kind == EmitterKind::Block)
+      count += static_cast<size_t>(latticeCount(e.boxMin.x(), e.boxMax.x(), s)) *
+               static_cast<size_t>(latticeCount(e.boxMin.y(), e.boxMax.y(), s)) *
+               static_cast<size_t>(latticeCount(e.boxMin.z(), e.boxMax.z(), s));
+  return std::min(count, static_cast<size_t>(std::max(model.solver.maxParticles, 0)));
 }
 
 }  // namespace soak

@@ -1,6 +1,10 @@
 // soak render and soak surface end to end (the soak binary, POV-Ray, ffmpeg) and the pieces they use:
 // camera framing, saturation colours, colliders at their keyframed pose, clear errors, no hang
-#include "render/render.hpp"
+#include <soak/render.hpp>
+
+#include "render/pov.hpp"
+#include "render/run_output.hpp"
+#include "render/surface.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

@@ -1,13 +1,57 @@
-// `soak render`: a run's output folder -> PNG frames (POV-Ray) -> an MP4 (ffmpeg). docs/rendering.md
+// soak's renderer, a library of its own (soak_render; the engine does not link it): a run's output
+// folder -> PNG frames (POV-Ray) -> an MP4 (ffmpeg), and the water surface of a run's frames as
+// meshes and level sets (OpenVDB). docs/rendering.md
 #pragma once
+#include <soak/math.hpp>
+#include <soak/scene.hpp>
+
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "render/pov.hpp"
-#include "render/surface.hpp"
-
 namespace soak {
+
+struct SurfaceSettings {
+  // voxel edge (m); 0: a sixth of the median support radius h (a third of the Table 1 spacing)
+  float voxelSize = 0.0f;
+  // ball radius of a particle as a fraction of its support radius h_i: h/2 is the spacing r0 at
+  // Table 1 values, so the balls of neighbours overlap and a block has no holes
+  float radiusFraction = 0.5f;
+  // distance the smoothed surface is moved inwards, as a fraction of the median h. The union of
+  // balls of radius r0 reaches r0 past the outer particles (less in the dimples between them); a
+  // lattice block's cells end r0/2 past them. 3/16 h was calibrated so resting blocks of 6^3 to
+  // 24^3 particles enclose their lattice volume to within 5% (tests/render/surface_test.cpp)
+  float erosionFraction = 0.1875f;
+  // a particle whose centre ends up outside the smoothed, eroded surface or less than a quarter of
+  // a drop radius inside it (a drip, a splash: the smoothing removes lone balls) is added back as a ball of
+  // this fraction of its h; 5/16 h is the
+  // radius of the sphere holding a Table 1 particle's volume (m / rho0)
+  float dropFraction = 0.3125f;
+  // Gaussian smoothing passes (width 1 voxel) of the level set before the erosion
+  int smoothingIterations = 1;
+  // narrow band half width in voxels
+  float halfWidth = 3.0f;
+};
+
+struct CameraSpec {
+  Vec3 position{0, 1, 3};
+  Vec3 lookAt{0, 0, 0};
+  float fovDegrees = 40.0f;  // horizontal
+};
+
+// what the user asked for; what is not given is chosen so that `bounds` fills the picture
+struct CameraRequest {
+  std::optional<Vec3> position, lookAt;
+  float fovDegrees = 40.0f;        // horizontal field of view
+  float azimuthDegrees = 35.0f;    // direction to the camera around y, from +z towards +x
+  float elevationDegrees = 25.0f;  // above the horizontal
+  float zoom = 1.0f;               // the automatic distance is divided by this
+};
+
+enum class WaterStyle { Surface, Particles };
+
 
 struct RenderOptions {
   std::string runDir;             // the folder `soak run` wrote
@@ -69,5 +113,9 @@ SurfaceResult surfaceRun(const SurfaceOptions& options, const std::function<void
 
 // the picture size of a PNG file from its IHDR chunk; throws soak::Error when it is not a PNG
 std::pair<int, int> pngSize(const std::string& path);
+
+// the view settings of the scene a run folder was written from (DIR/scene.json); throws soak::Error
+// as renderRun does for a missing or broken folder
+ViewSettings runView(const std::string& runDir);
 
 }  // namespace soak

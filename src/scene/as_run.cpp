@@ -1,0 +1,40 @@
+// the scene as a run uses it (soak/scene.hpp: sceneAsRun)
+#include <soak/output.hpp>
+#include <soak/scene.hpp>
+
+#include "scene/overrides.hpp"
+
+#include <filesystem>
+
+namespace soak {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// relative file paths in the scene ("mesh": {"path": ...}) made absolute against baseDir
+void resolvePaths(nlohmann::json& v, const fs::path& baseDir) {
+  if (v.is_object()) {
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      if (it.key() == "path" && it->is_string()) {
+        const fs::path p = it->get<std::string>();
+        if (p.is_relative() && fs::exists(baseDir / p)) *it = fs::absolute(baseDir / p).lexically_normal().string();
+      } else {
+        resolvePaths(*it, baseDir);
+      }
+    }
+  } else if (v.is_array()) {
+    for (auto& e : v) resolvePaths(e, baseDir);
+  }
+}
+
+}  // namespace
+
+std::string sceneAsRun(const std::string& path, const std::vector<std::string>& overrides) {
+  nlohmann::json doc = parseSceneJson(readTextFile(path), path);
+  applyOverrides(doc, overrides, path);
+  resolvePaths(doc, fs::absolute(path).parent_path());
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace soak
