@@ -1,6 +1,8 @@
 // water emitters: block lattice, jet discs evenly spaced at the jet speed, timing, particle cap
 #include "world/emitters.hpp"
 
+#include <soak/scene.hpp>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -174,6 +176,30 @@ void checkJet(const Vec3& direction, float dt, int steps) {
   ASSERT_EQ(levels.size(), total / perDisc);
   for (size_t k = 1; k < levels.size(); ++k) EXPECT_NEAR(levels[k] - levels[k - 1], m.water.spacing, 1e-4f);
   EXPECT_NEAR(s.ledger.emitted, static_cast<double>(total) * m.water.particleMass, 1e-6);
+}
+
+// soak validate's count of the water the blocks will make: the particles emitBlock creates, a jet not
+// counted, the total capped at solver.maxParticles
+TEST(EmitterBlock, BlockParticleCountIsWhatTheBlocksEmit) {
+  Model m = blockModel();
+  Emitter second = m.emitters[0];
+  second.boxMin = Vec3(-0.5f, 1.0f, -0.05f);
+  second.boxMax = Vec3(-0.4f, 1.06f, 0.05f);
+  second.start = 0.3f;
+  m.emitters.push_back(second);
+  Emitter jet;
+  jet.kind = EmitterKind::Jet;
+  m.emitters.push_back(jet);
+  State state;
+  state.emitters.resize(m.emitters.size());
+  m.emitters.pop_back();  // the jet's particles are not the blocks'
+  state.emitters.pop_back();
+  const size_t emitted = emitWater(m, state, 0.0, 1.0f);
+  ASSERT_EQ(emitted, 125u + 5u * 3u * 5u);
+  m.emitters.push_back(jet);
+  EXPECT_EQ(blockParticleCount(m), emitted);
+  m.solver.maxParticles = 100;
+  EXPECT_EQ(blockParticleCount(m), 100u);
 }
 
 TEST(EmitterJet, DiscsEvenlySpacedWithSmallSteps) { checkJet(Vec3(0, -1, 0), 0.001f, 100); }
