@@ -105,24 +105,15 @@ struct DripDirections {
   }
 };
 
-}  // namespace
-
-size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
-                       const std::vector<ColliderPose>& poses, WettingScratch& s, float h) {
-  s.pairFloat.prepare();  // the per-thread pair buffers of the loops below
-  s.pairDouble.prepare();
+// 1. water above S^EW goes into the buffer, then S_i (computeSaturation's) of what stays
+void fillBuffers(const Model& model, State& state, const WettingScratch& s) {
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
-  if (!w.enabled || !w.emission || nc == 0) return 0;
-  Particles& p = state.particles;
-  const Vec3 g = gravityDirection(model);
-  const float gMag = model.solver.gravity.norm();
   const double c = w.c;
-
-  // 1. water above S^EW goes into the buffer: EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as
-  // computeSaturation, in the same loop. A buffer holding m^threshold (a drip that found no place,
-  // under water) takes no more, from its particle or from above (step 3), so a sheet under water does
-  // not pump the pool into its buffers (departure: docs/models.md)
+  // EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as computeSaturation, in the same loop. A buffer
+  // holding m^threshold (a drip that found no place, under water) takes no more, from its particle or
+  // from above (moveBuffersDown), so a sheet under water does not pump the pool into its buffers
+  // (departure: docs/models.md)
   const double full = static_cast<double>(w.massThreshold);
   std::vector<float>& sat = state.clothSaturation;
   sat.resize(static_cast<size_t>(nc));
@@ -135,30 +126,47 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     }
     sat[i] = saturationOf(c, state.clothWater[i], s.volume[i]);
   });
-  const uint32_t cloth = static_cast<uint32_t>(nc);  // loops below read the cloth part of the lists
+}
 
-  // the pairs' cos theta, poly6 and spiky gradient factor (pairGeometry): cos theta_ji is exactly
-  // -cos theta_ij and the kernels are symmetric, so the numbers are the same seen from either side
+// the neighbour loops' inputs: pointers into the lists, the particles, the saturation, volume and
+// buffers, and the pairs' cos theta, poly6 and spiky gradient factor (pairGeometry): cos theta_ji is
+// exactly -cos theta_ij and the kernels are symmetric, so the numbers are the same seen from either side.
+// Each loop computes the pairs' terms in a vectorised loop (plain floats and doubles, selects, the
+// arithmetic of the scalar expressions) into a per-thread buffer and sums them in list order, so every
+// result is that of the scalar loop. A pair the scalar loop skipped contributes a zero, which leaves a
+// sum started at +0 unchanged. Pointers are copied into the loops' own locals: the compiler does not
+// vectorise loads through a lambda's captures.
+struct FlowInputs {
+  const uint32_t* indexAll;
+  const int32_t* phaseAll;
+  const float* xAll;
+  const float* satAll;
+  const float* volumeAll;
+  const double* bufferAll;
+  const float *cosG, *poly, *spikyF;
+};
+
+FlowInputs flowInputs(const Model& model, const State& state, const NeighborLists& nb, WettingScratch& s) {
+  const Particles& p = state.particles;
   ensurePairGeometry(model, p, nb, s);
-  const float* cosG = s.pairCos.data();
-  const float* poly = s.pairPoly6.data();
-  const float* spikyF = s.pairSpiky.data();
+  return {nb.index.data(), p.phase.data(), p.x[0].data(), state.clothSaturation.data(), s.volume.data(),
+          state.clothBuffer.data(), s.pairCos.data(), s.pairPoly6.data(), s.pairSpiky.data()};
+}
 
-  // Each neighbour loop below computes the pairs' terms in a vectorised loop (plain floats and
-  // doubles, selects, the arithmetic of the scalar expressions) into a per-thread buffer and sums them
-  // in list order, so every result is that of the scalar loop. A pair the scalar loop skipped
-  // contributes a zero, which leaves a sum started at +0 unchanged. Pointers are copied into the
-  // loops' own locals: the compiler does not vectorise loads through a lambda's captures.
-  const uint32_t* const indexAll = nb.index.data();
-  const int32_t* const phaseAll = p.phase.data();
-  const float* const xAll = p.x[0].data();
-  const float* const satAll = sat.data();
-  const float* const volumeAll = s.volume.data();
-  const double* const bufferAll = state.clothBuffer.data();
-
-  // 2. Eq. 18: does gravity beat the pull of the wet neighbours above?
+// 2. Eq. 18: s.transfers[i] when gravity beats the pull of i's wet neighbours above
+void markTransfers(const Model& model, const NeighborLists& nb, const FlowInputs& in, WettingScratch& s) {
+  const int64_t nc = model.numCloth;
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const uint32_t* const indexAll = in.indexAll;
+  const int32_t* const phaseAll = in.phaseAll;
+  const float* const xAll = in.xAll;
+  const float* const satAll = in.satAll;
+  const float* const volumeAll = in.volumeAll;
+  const double* const bufferAll = in.bufferAll;
+  const float* const cosG = in.cosG;
+  const float* const spikyF = in.spikyF;
   s.transfers.assign(static_cast<size_t>(nc), 0);
-  const float pullLimit = w.beta * gMag;
+  const float pullLimit = model.wetting.beta * model.solver.gravity.norm();
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     if (bufferAll[i] <= 0.0) return;
     const uint32_t begin = nb.start[i], count = nb.clothEnd(i, cloth) - begin;
@@ -195,7 +203,22 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     for (uint32_t k = 0; k < count; ++k) pull += Vec3(Tx[k], Ty[k], Tz[k]);
     s.transfers[i] = pull.norm() < pullLimit;
   });
-  // 3. the buffer of an upper particle u flowing to a lower neighbour l, before and after scaling:
+}
+
+// 3. the buffers flow down to the neighbours below (Eq. 18's transfer), over a wetting pass of h
+void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, const FlowInputs& in,
+                     WettingScratch& s, float h) {
+  const WettingParams& w = model.wetting;
+  const int64_t nc = model.numCloth;
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const double full = static_cast<double>(w.massThreshold);
+  const uint32_t* const indexAll = in.indexAll;
+  const int32_t* const phaseAll = in.phaseAll;
+  const float* const volumeAll = in.volumeAll;
+  const double* const bufferAll = in.bufferAll;
+  const float* const cosG = in.cosG;
+  const float* const poly = in.poly;
+  // the buffer of an upper particle u flowing to a lower neighbour l, before and after scaling:
   // rate cos theta_lu V_u W_lu EW_u; cos theta_lu > 0 (l below u) and W_lu = poly6(|x_l - x_u|^2, h_lu)
   // are the pair's numbers (pairGeometry), the same seen from u or l
   const double rate = std::min(1.0, static_cast<double>(h) / w.rateStep);
@@ -281,11 +304,17 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   }
   parallelFor(nc, [&](int64_t i) { state.clothBuffer[i] = std::max(0.0, state.clothBuffer[i] + s.delta[i]); });
 
+}
+
+// 4a. the drips still hanging: kept in state.dripId / dripSource and in s.dripOf (the drip of each
+// source, -1: none), each fed from its source's buffer up to maxDrip
+void feedHangingDrips(const Model& model, State& state, WettingScratch& s, float maxDrip) {
+  const int64_t nc = model.numCloth;
+  Particles& p = state.particles;
+  const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
   // 4. drips, serially in cloth order (few; new ids in a fixed order). Drips that are gone, have
   // fallen out of their source's reach or have grown to the largest drip mass are let go; a source
   // keeps feeding its hanging drip up to that mass (departure: docs/models.md)
-  const float m0 = model.water.particleMass, h0 = model.water.supportRadius, rho0 = model.water.restDensity;
-  const float maxDrip = std::max(w.maxDripMass > 0.0f ? w.maxDripMass : 4.0f * m0, w.massThreshold);
   std::vector<int64_t>& dripOf = s.dripOf;
   dripOf.assign(static_cast<size_t>(nc), -1);
   size_t kept = 0;
@@ -311,6 +340,18 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
     p.setMass(static_cast<size_t>(q), after, false);
     p.radius[q] = std::cbrt(after / m0) * h0;
   }
+}
+
+// 4b. a new drip below every source whose buffer holds m^threshold and that has none hanging, at the
+// first place with room (Eq. 18's emission; the places: DripDirections); returns how many
+size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
+                     const std::vector<ColliderPose>& poses, WettingScratch& s) {
+  const WettingParams& w = model.wetting;
+  const int64_t nc = model.numCloth;
+  Particles& p = state.particles;
+  const Vec3 g = gravityDirection(model);
+  const float m0 = model.water.particleMass, h0 = model.water.supportRadius, rho0 = model.water.restDensity;
+  const std::vector<int64_t>& dripOf = s.dripOf;
   const size_t gridSize = grid.cellEntries.size();
   const float mDrip = w.massThreshold;
   const float hDrip = std::cbrt(mDrip / m0) * h0;  // h_p = (m_p / m0)^(1/3) h0
@@ -378,6 +419,24 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   }
   state.ledger.dripsEmitted += made;
   return made;
+}
+
+}  // namespace
+
+size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
+                       const std::vector<ColliderPose>& poses, WettingScratch& s, float h) {
+  s.pairFloat.prepare();  // the per-thread pair buffers of the loops below
+  s.pairDouble.prepare();
+  const WettingParams& w = model.wetting;
+  if (!w.enabled || !w.emission || model.numCloth == 0) return 0;
+  fillBuffers(model, state, s);                                    // S > S^EW: into the buffer
+  const FlowInputs in = flowInputs(model, state, nb, s);
+  markTransfers(model, nb, in, s);                                 // Eq. 18: gravity beats the pull above
+  moveBuffersDown(model, state, nb, in, s, h);                     // the buffers flow down
+  const float maxDrip = std::max(w.maxDripMass > 0.0f ? w.maxDripMass : 4.0f * model.water.particleMass,
+                                 w.massThreshold);
+  feedHangingDrips(model, state, s, maxDrip);                      // hanging drips grow, or let go
+  return placeNewDrips(model, state, nb, grid, poses, s);          // new drips where there is room
 }
 
 // f_p = sum_i kappa^e (m_i + eta^e S_i) (Psi_i / rho0) W(x_ip, h_p) along x_i - x_p (Eq. 19), Psi_i =
