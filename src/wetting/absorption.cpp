@@ -27,37 +27,38 @@ void markDrips(const Model& model, const State& state, std::vector<uint8_t>& isD
     if (q >= 0) isDrip[static_cast<size_t>(q)] = 1;
 }
 
-}  // namespace
+// Eq. 11's request: the most cloth particle i may take from water particle j this pass (kg)
+struct Requests {
+  const Particles& p;
+  const std::vector<float>& capacity;
+  float kappa, eta;
+  Vec3 g;
+  float operator()(int64_t i, int64_t j) const {
+    return kappa * (1.0f + eta * cosGravity(p.x[i], p.x[j], g)) * capacity[i];
+  }
+};
 
-size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h) {
-  s.anyAbsorbedWhole = false;
+// what each cloth particle can still take, kg: (S^MAX - S_i) V_i / c, the buffer counting as held
+void clothCapacity(const Model& model, const State& state, WettingScratch& s) {
   const WettingParams& w = model.wetting;
-  Particles& p = state.particles;
   const int64_t nc = model.numCloth;
-  const int64_t n = static_cast<int64_t>(p.size());
-  if (!w.enabled || !w.absorption || nc == 0 || n == nc) return 0;
-  const float kappa = rateForStep(w.absorptionRate, h, w.rateStep);
-  const float eta = w.absorptionGravity;
-  const Vec3 g = gravityDirection(model);
-  const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
-  const float minMass = w.minMassFraction * m0;
-  const uint32_t cloth = static_cast<uint32_t>(nc);  // water lists: their cloth part holds the absorbers
-
-  // what each cloth particle can still take, kg: (S^MAX - S_i) V_i / c, the buffer counting as held
   s.capacity.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
     const double room = static_cast<double>(w.saturationMax) * s.volume[i] / w.c - state.clothWater[i] -
                         state.clothBuffer[i];
     s.capacity[i] = static_cast<float>(std::max(0.0, room));
   });
-  markDrips(model, state, s.isDrip);
-  // Eq. 11: the most cloth particle i may take from water particle j
-  const auto request = [&](int64_t i, int64_t j) {
-    return kappa * (1.0f + eta * cosGravity(p.x[i], p.x[j], g)) * s.capacity[i];
-  };
-  const auto absorbs = [&](int64_t j) { return isWater(p.phase[j]) && !s.isDrip[j]; };
+}
 
-  // 1. per water particle: the share of the requests its mass can meet (gather)
+// the shares of the requests that can be met: per water particle, of its mass (s.waterScale); per
+// cloth particle, of its capacity (s.clothScale); both gathered
+void shareRequests(const Model& model, const Particles& p, const NeighborLists& nb, const Requests& request,
+                   WettingScratch& s) {
+  const int64_t nc = model.numCloth;
+  const int64_t n = static_cast<int64_t>(p.size());
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const auto absorbs = [&](int64_t j) { return isWater(p.phase[j]) && !s.isDrip[j]; };
+  // per water particle: the share of the requests its mass can meet
   s.waterScale.assign(static_cast<size_t>(n), 0.0f);
   parallelFor(n - nc, [&](int64_t k) {
     const int64_t j = nc + k;
@@ -69,7 +70,7 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     }
     if (total > 0.0f) s.waterScale[j] = total > p.mass[j] ? p.mass[j] / total : 1.0f;
   });
-  // 2. per cloth particle: the share of what it is offered that fits its capacity (gather)
+  // per cloth particle: the share of what it is offered that fits its capacity
   s.clothScale.assign(static_cast<size_t>(nc), 0.0f);
   parallelFor(nc, [&](int64_t i) {
     if (s.capacity[i] <= 0.0f) return;
@@ -80,7 +81,17 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     }
     s.clothScale[i] = offered > s.capacity[i] ? s.capacity[i] / offered : 1.0f;
   });
-  // 3. per water particle: what it loses; partial absorption shrinks it, a remnant is taken whole
+}
+
+// what each water particle loses (s.waterLost): partial absorption shrinks it, a remnant is taken
+// whole (s.keep[j] = 0)
+void shrinkWater(const Model& model, Particles& p, const NeighborLists& nb, const Requests& request,
+                 WettingScratch& s) {
+  const int64_t nc = model.numCloth;
+  const int64_t n = static_cast<int64_t>(p.size());
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
+  const float minMass = model.wetting.minMassFraction * m0;
   s.waterLost.assign(static_cast<size_t>(n), 0.0);
   s.keep.assign(static_cast<size_t>(n), 1);
   parallelFor(n - nc, [&](int64_t k) {
@@ -104,11 +115,17 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
     p.radius[j] = std::cbrt(after / m0) * h0;  // h' = (m'/m0)^(1/3) h0, the adaptive sampling of Eq. 11
     s.waterLost[j] = static_cast<double>(before) - static_cast<double>(after);  // exact: both are floats
   });
-  // 4. the cloth gains in a fixed order (water ascending, neighbours in list order): each water
-  // particle's loss split over its absorbers by their share, the last taking the remainder exactly.
-  // The shares in parallel per water particle; then each cloth particle takes its gains in ascending
-  // water order, the order of a serial loop over the water, in parallel per cloth particle: a gain
-  // changes only its own cloth particle, so no sum depends on the thread count
+}
+
+// each water particle's loss split over its absorbers by their share, the last taking the remainder
+// exactly (s.gain, one slot per entry of its list's cloth part from s.lostStart), in parallel per
+// water particle; counts the water particles absorbed whole in the ledger and returns how many.
+// anyLost: whether any water particle lost water
+size_t splitLosses(const Model& model, State& state, const NeighborLists& nb, const Requests& request,
+                   WettingScratch& s, bool& anyLost) {
+  const int64_t nc = model.numCloth;
+  const int64_t n = static_cast<int64_t>(state.particles.size());
+  const uint32_t cloth = static_cast<uint32_t>(nc);
   const int64_t nw = n - nc;
   s.lostStart.resize(static_cast<size_t>(nw) + 1);
   s.lostStart[0] = 0;
@@ -118,7 +135,8 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
   for (int64_t j = nc; j < n; ++j) whole += s.waterLost[j] > 0.0 && !s.keep[j] ? 1 : 0;
   s.anyAbsorbedWhole = whole > 0;
   state.ledger.particlesAbsorbed += whole;
-  if (s.lostStart[nw] == 0) return whole;  // no water lost any: nothing to hand out
+  anyLost = s.lostStart[nw] > 0;
+  if (!anyLost) return whole;  // nothing to hand out
   s.gain.resize(s.lostStart[nw]);
   s.absorber.resize(s.lostStart[nw]);
   parallelFor(nw, [&](int64_t k) {
@@ -145,6 +163,13 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       gain[e - e0] = g;
     }
   });
+  return whole;
+}
+
+// s.gainFirst / gainSlot / gainWater: the gains' slots by cloth particle, water ascending
+void sortGainsByCloth(const Model& model, const State& state, const NeighborLists& nb, WettingScratch& s) {
+  const int64_t nc = model.numCloth;
+  const int64_t nw = static_cast<int64_t>(state.particles.size()) - nc;
   // the slots by cloth particle, water ascending: counted and placed per thread over a contiguous
   // range of the water, the ranges in thread order
   const int threads = threadCount();
@@ -186,6 +211,13 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       s.gainWater[to] = j;
     });
   }
+}
+
+// each cloth particle takes its gains in that order, with their momentum
+void applyGains(const Model& model, State& state, const WettingScratch& s) {
+  const int64_t nc = model.numCloth;
+  Particles& p = state.particles;
+  const std::vector<uint32_t>& first = s.gainFirst;
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     for (uint32_t g = first[static_cast<size_t>(i)]; g < first[static_cast<size_t>(i) + 1]; ++g) {
       const double gain = s.gain[s.gainSlot[g]];
@@ -197,6 +229,30 @@ size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, We
       p.setMass(static_cast<size_t>(i), mi + dm, model.clothPinned[i]);  // dry + held: porosity's sum, in steps
     }
   });
+}
+
+}  // namespace
+
+size_t absorbWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h) {
+  s.anyAbsorbedWhole = false;
+  const WettingParams& w = model.wetting;
+  Particles& p = state.particles;
+  const int64_t nc = model.numCloth;
+  if (!w.enabled || !w.absorption || nc == 0 || static_cast<int64_t>(p.size()) == nc) return 0;
+  clothCapacity(model, state, s);
+  markDrips(model, state, s.isDrip);  // drips are held by Eq. 19, not soaked up
+  const Requests request{p, s.capacity, rateForStep(w.absorptionRate, h, w.rateStep), w.absorptionGravity,
+                         gravityDirection(model)};
+  shareRequests(model, p, nb, request, s);
+  shrinkWater(model, p, nb, request, s);
+  // the cloth gains in a fixed order (water ascending, neighbours in list order), the order of a serial
+  // loop over the water, in parallel per cloth particle: a gain changes only its own cloth particle,
+  // so no sum depends on the thread count
+  bool anyLost = false;
+  const size_t whole = splitLosses(model, state, nb, request, s, anyLost);
+  if (!anyLost) return whole;
+  sortGainsByCloth(model, state, nb, s);
+  applyGains(model, state, s);
   return whole;
 }
 
