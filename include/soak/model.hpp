@@ -143,7 +143,7 @@ struct Model {
   std::vector<Vec3> clothRestPosition;           // m, per cloth particle (initial shape)
   std::vector<float> clothDryMass;               // kg, per cloth particle
   std::vector<uint8_t> clothPinned;              // 1 = follows clothRestPosition (kinematic)
-  std::vector<uint8_t> clothImplicit;            // 1 = in a piece solved implicitly (skipped by the PBD stages)
+  std::vector<uint8_t> clothImplicit;            // 1 = in a piece solved implicitly (moved by src/garment)
   std::vector<int> vertexTriangleStart;          // CSR: triangles around a cloth particle
   std::vector<int> vertexTriangles;
   std::vector<int> vertexNeighborStart;          // CSR: cloth particles sharing an edge (1-ring)
@@ -155,7 +155,7 @@ struct Model {
   std::vector<Collider> colliders;
   std::vector<Emitter> emitters;
 
-  // particle i is a cloth particle of a piece solved implicitly (Chen 2012), which the PBD stages skip
+  // particle i is a cloth particle of a piece solved implicitly (Chen 2012), moved by src/garment only
   bool implicitCloth(int64_t i) const {
     return i >= 0 && i < static_cast<int64_t>(clothImplicit.size()) && clothImplicit[static_cast<size_t>(i)] != 0;
   }
