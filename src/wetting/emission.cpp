@@ -205,9 +205,14 @@ void markTransfers(const Model& model, const NeighborLists& nb, const FlowInputs
   });
 }
 
-// 3. the buffers flow down to the neighbours below (Eq. 18's transfer), over a wetting pass of h
-void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, const FlowInputs& in,
-                     WettingScratch& s, float h) {
+// Eq. 18's transfer: the buffer of an upper particle u flows to a lower neighbour l at
+// rate cos theta_lu V_u W_lu EW_u; cos theta_lu > 0 (l below u) and W_lu = poly6(|x_l - x_u|^2, h_lu)
+// are the pair's numbers (pairGeometry), the same seen from u or l. rate = min(1, h / rateStep).
+
+// s.outScale[u]: the share of each shedding particle's flows its buffer can pay (1 but where strongly
+// compressed cloth asks for more than it holds; 0 where it does not shed)
+void outflowScales(const Model& model, const NeighborLists& nb, const FlowInputs& in, double rate,
+                   WettingScratch& s) {
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
@@ -218,92 +223,109 @@ void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, 
   const double* const bufferAll = in.bufferAll;
   const float* const cosG = in.cosG;
   const float* const poly = in.poly;
-  // the buffer of an upper particle u flowing to a lower neighbour l, before and after scaling:
-  // rate cos theta_lu V_u W_lu EW_u; cos theta_lu > 0 (l below u) and W_lu = poly6(|x_l - x_u|^2, h_lu)
-  // are the pair's numbers (pairGeometry), the same seen from u or l
-  const double rate = std::min(1.0, static_cast<double>(h) / w.rateStep);
+  s.outScale.assign(static_cast<size_t>(nc), 0.0f);  // stays 0 exactly where transfers is 0
+  parallelForDynamic(nc, kWetChunk, [&](int64_t u) {
+    if (!s.transfers[u]) return;
+    const uint32_t begin = nb.start[u], count = nb.clothEnd(u, cloth) - begin;
+    const uint32_t* const J = indexAll + begin;
+    const float* const C = cosG + begin;
+    const float* const W = poly + begin;
+    const int32_t* const P = phaseAll;
+    double* const T = s.pairDouble.get(count);
+    const uint32_t clothL = cloth;
+    const int32_t phu = P[u];
+    const float vu = volumeAll[u];
+    const double* const B = bufferAll;
+    const double bu = bufferAll[u], rateL = rate, fullL = full;
+#pragma omp simd
+    for (uint32_t k = 0; k < count; ++k) {
+      const uint32_t l = J[k];
+      const bool same = (l < clothL) & (P[l] == phu);
+      const uint32_t ll = same ? l : static_cast<uint32_t>(u);  // buffers hold cloth only
+      const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
+      const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL);  // and l's buffer takes water
+      const float vw = vu * W[k];
+      T[k] = rateL * static_cast<double>(cosLU * vw * (below ? 1.0f : 0.0f)) * bu;  // +-0 where not below
+    }
+    double out = 0.0;
+    for (uint32_t k = 0; k < count; ++k) out += T[k];
+    // the fractions sum below one; this only guards strongly compressed cloth
+    s.outScale[u] = out > bu ? static_cast<float>(bu / out) : 1.0f;
+  });
+}
+
+// s.delta[k]: what arrives at k from above minus what leaves it below, gathered per particle, the same
+// numbers both ways. outScale > 0 stands for transfers (a shedding particle's scale is positive; were
+// it 0 its flows would be zeros anyway)
+void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in, double rate, WettingScratch& s) {
+  const WettingParams& w = model.wetting;
+  const int64_t nc = model.numCloth;
+  const uint32_t cloth = static_cast<uint32_t>(nc);
+  const double full = static_cast<double>(w.massThreshold);
+  const uint32_t* const indexAll = in.indexAll;
+  const int32_t* const phaseAll = in.phaseAll;
+  const float* const volumeAll = in.volumeAll;
+  const double* const bufferAll = in.bufferAll;
+  const float* const cosG = in.cosG;
+  const float* const poly = in.poly;
+  const float* const outScaleAll = s.outScale.data();
+  s.delta.resize(static_cast<size_t>(nc));
+  parallelForDynamic(nc, kWetChunk, [&](int64_t k) {
+    // no flow either way unless k or a neighbour sheds (most of a cloth): d stays +0
+    bool sheds = s.transfers[k];
+    for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end && !sheds; ++e)
+      sheds = nb.index[e] < cloth && s.transfers[nb.index[e]];
+    if (!sheds) {
+      s.delta[k] = 0.0;
+      return;
+    }
+    const uint32_t begin = nb.start[k], count = nb.clothEnd(k, cloth) - begin;
+    const uint32_t* const J = indexAll + begin;
+    const float* const C = cosG + begin;
+    const float* const W = poly + begin;
+    const int32_t* const P = phaseAll;
+    const float* const VL = volumeAll;
+    const float* const OS = outScaleAll;
+    const double* const B = bufferAll;
+    double* const T = s.pairDouble.get(count);
+    const uint32_t clothL = cloth;
+    const int32_t phk = P[k];
+    const float vk = VL[k], osk = OS[k];
+    const double bk = B[k], rateL = rate, fullL = full;
+#pragma omp simd
+    for (uint32_t e = 0; e < count; ++e) {
+      const uint32_t j = J[e];
+      const bool same = (j < clothL) & (P[j] == phk);
+      const uint32_t jj = same ? j : static_cast<uint32_t>(k);
+      const float cosKJ = C[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
+      const float osj = OS[jj];
+      const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullL);     // j sheds into k
+      const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL);   // k sheds into j
+      // outScale_u * rawFlow(u), rawFlow = rate (cos theta_lu V_u W) EW_u
+      const double in = static_cast<double>(osj) * (rateL * static_cast<double>(cosKJ * (VL[jj] * W[e])) * B[jj]);
+      const double out = static_cast<double>(osk) * (rateL * static_cast<double>(-cosKJ * (vk * W[e])) * bk);
+      T[e] = in * (fromJ ? 1.0 : 0.0) - out * (toJ ? 1.0 : 0.0);  // in, -out or +-0
+    }
+    double d = 0.0;
+    for (uint32_t e = 0; e < count; ++e) d += T[e];
+    s.delta[k] = d;
+  });
+}
+
+// 3. the buffers flow down to the neighbours below, over a wetting pass of h
+void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, const FlowInputs& in,
+                     WettingScratch& s, float h) {
+  const int64_t nc = model.numCloth;
+  const double rate = std::min(1.0, static_cast<double>(h) / model.wetting.rateStep);
   int anyTransfer = 0;
   for (int64_t i = 0; i < nc && !anyTransfer; ++i) anyTransfer = s.transfers[i];
   if (anyTransfer) {
-    s.outScale.assign(static_cast<size_t>(nc), 0.0f);  // stays 0 exactly where transfers is 0
-    const float* const outScaleAll = s.outScale.data();
-    parallelForDynamic(nc, kWetChunk, [&](int64_t u) {
-      if (!s.transfers[u]) return;
-      const uint32_t begin = nb.start[u], count = nb.clothEnd(u, cloth) - begin;
-      const uint32_t* const J = indexAll + begin;
-      const float* const C = cosG + begin;
-      const float* const W = poly + begin;
-      const int32_t* const P = phaseAll;
-      double* const T = s.pairDouble.get(count);
-      const uint32_t clothL = cloth;
-      const int32_t phu = P[u];
-      const float vu = volumeAll[u];
-      const double* const B = bufferAll;
-      const double bu = bufferAll[u], rateL = rate, fullL = full;
-#pragma omp simd
-      for (uint32_t k = 0; k < count; ++k) {
-        const uint32_t l = J[k];
-        const bool same = (l < clothL) & (P[l] == phu);
-        const uint32_t ll = same ? l : static_cast<uint32_t>(u);  // buffers hold cloth only
-        const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
-        const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL);  // and l's buffer takes water
-        const float vw = vu * W[k];
-        T[k] = rateL * static_cast<double>(cosLU * vw * (below ? 1.0f : 0.0f)) * bu;  // +-0 where not below
-      }
-      double out = 0.0;
-      for (uint32_t k = 0; k < count; ++k) out += T[k];
-      // the fractions sum below one; this only guards strongly compressed cloth
-      s.outScale[u] = out > bu ? static_cast<float>(bu / out) : 1.0f;
-    });
-    // gathered per particle: what arrives from above minus what leaves below, the same numbers both
-    // ways. outScale > 0 stands for transfers (a shedding particle's scale is positive; were it 0 its
-    // flows would be zeros anyway)
-    s.delta.resize(static_cast<size_t>(nc));
-    parallelForDynamic(nc, kWetChunk, [&](int64_t k) {
-      // no flow either way unless k or a neighbour sheds (most of a cloth): d stays +0
-      bool sheds = s.transfers[k];
-      for (uint32_t e = nb.start[k], end = nb.clothEnd(k, cloth); e < end && !sheds; ++e)
-        sheds = nb.index[e] < cloth && s.transfers[nb.index[e]];
-      if (!sheds) {
-        s.delta[k] = 0.0;
-        return;
-      }
-      const uint32_t begin = nb.start[k], count = nb.clothEnd(k, cloth) - begin;
-      const uint32_t* const J = indexAll + begin;
-      const float* const C = cosG + begin;
-      const float* const W = poly + begin;
-      const int32_t* const P = phaseAll;
-      const float* const VL = volumeAll;
-      const float* const OS = outScaleAll;
-      const double* const B = bufferAll;
-      double* const T = s.pairDouble.get(count);
-      const uint32_t clothL = cloth;
-      const int32_t phk = P[k];
-      const float vk = VL[k], osk = OS[k];
-      const double bk = B[k], rateL = rate, fullL = full;
-#pragma omp simd
-      for (uint32_t e = 0; e < count; ++e) {
-        const uint32_t j = J[e];
-        const bool same = (j < clothL) & (P[j] == phk);
-        const uint32_t jj = same ? j : static_cast<uint32_t>(k);
-        const float cosKJ = C[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
-        const float osj = OS[jj];
-        const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullL);     // j sheds into k
-        const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL);   // k sheds into j
-        // outScale_u * rawFlow(u), rawFlow = rate (cos theta_lu V_u W) EW_u
-        const double in = static_cast<double>(osj) * (rateL * static_cast<double>(cosKJ * (VL[jj] * W[e])) * B[jj]);
-        const double out = static_cast<double>(osk) * (rateL * static_cast<double>(-cosKJ * (vk * W[e])) * bk);
-        T[e] = in * (fromJ ? 1.0 : 0.0) - out * (toJ ? 1.0 : 0.0);  // in, -out or +-0
-      }
-      double d = 0.0;
-      for (uint32_t e = 0; e < count; ++e) d += T[e];
-      s.delta[k] = d;
-    });
+    outflowScales(model, nb, in, rate, s);
+    netFlows(model, nb, in, rate, s);
   } else {
     s.delta.assign(static_cast<size_t>(nc), 0.0);
   }
   parallelFor(nc, [&](int64_t i) { state.clothBuffer[i] = std::max(0.0, state.clothBuffer[i] + s.delta[i]); });
-
 }
 
 // 4a. the drips still hanging: kept in state.dripId / dripSource and in s.dripOf (the drip of each
