@@ -8,7 +8,11 @@
 
 namespace soak {
 
-inline float pairRadius(float hi, float hj) { return 0.5f * (hi + hj); }
+// (a template on the lane type: float or simd::FloatW, core/simd.hpp)
+template <class F>
+inline F pairRadius(F hi, F hj) {
+  return 0.5f * (hi + hj);
+}
 
 // The kernels' normalisations, the only place their constants are written. The loops that vectorise
 // (pbd/fluid.cpp, wetting/) call these small functions with the same arithmetic as the kernels below,
@@ -21,13 +25,16 @@ inline float poly6Coef(float h, float h2) { return 315.0f / (64.0f * kPi * (h2 *
 inline float spikyGradCoef(float h3) { return -45.0f / (kPi * h3 * h3); }
 // 45 / (pi h^6), h3 = h^3: the factor of (h - r) in the viscosity kernel's Laplacian
 inline float viscosityLaplacianCoef(float h3) { return 45.0f / (kPi * h3 * h3); }
-// the same factors from 1 / h, with one division a pair instead of one per factor
-inline float poly6CoefOfInverse(float inv) {
-  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+// the same factors from 1 / h, with one division a pair instead of one per factor (templates on the
+// lane type, for the vectorised loops)
+template <class F>
+inline F poly6CoefOfInverse(F inv) {
+  const F inv3 = inv * inv * inv, inv6 = inv3 * inv3;
   return kPoly6Norm * inv6 * inv3;
 }
-inline float spikyGradCoefOfInverse(float inv) {
-  const float inv3 = inv * inv * inv, inv6 = inv3 * inv3;
+template <class F>
+inline F spikyGradCoefOfInverse(F inv) {
+  const F inv3 = inv * inv * inv, inv6 = inv3 * inv3;
   return kSpikyGradNorm * inv6;
 }
 
