@@ -9,6 +9,7 @@
 // scalar overloads exist and the loops take their scalar paths.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -26,6 +27,8 @@ namespace soak::simd {
 inline float max(float a, float b) { return a > b ? a : b; }
 inline float min(float a, float b) { return a < b ? a : b; }
 inline float sqrt(float a) { return std::sqrt(a); }
+// x limited to [lo, hi] as std::min(std::max(x, lo), hi): a NaN x stays NaN
+inline float clamp(float x, float lo, float hi) { return std::min(std::max(x, lo), hi); }
 inline float select(bool m, float a) { return m ? a : 0.0f; }  // a where m, else 0
 inline float divideOrZero(bool m, float a, float b) { return m ? a / b : 0.0f; }
 
@@ -67,6 +70,10 @@ inline FloatW& operator-=(FloatW& a, FloatW b) { return a = a - b; }
 // the maskz forms with every lane here: the plain ones draw a false -Wmaybe-uninitialized warning
 inline FloatW max(FloatW a, FloatW b) { return FloatW(_mm512_maskz_max_ps(kAll, a.v, b.v)); }
 inline FloatW min(FloatW a, FloatW b) { return FloatW(_mm512_maskz_min_ps(kAll, a.v, b.v)); }
+inline FloatW clamp(FloatW x, FloatW lo, FloatW hi) {
+  const __m512 up = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(x.v, lo.v, _CMP_LT_OQ), x.v, lo.v);
+  return FloatW(_mm512_mask_blend_ps(_mm512_cmp_ps_mask(hi.v, up, _CMP_LT_OQ), up, hi.v));
+}
 inline FloatW sqrt(FloatW a) { return FloatW(_mm512_maskz_sqrt_ps(kAll, a.v)); }
 inline FloatW select(MaskW m, FloatW a) { return FloatW(_mm512_maskz_mov_ps(m.bits, a.v)); }
 // a / b in the lanes of m (the others are not divided), 0 elsewhere

@@ -1,11 +1,10 @@
 #include "grid/grid.hpp"
 
+#include "core/kernels.hpp"
 #include "core/parallel.hpp"
+#include "core/simd.hpp"
 
 #include <omp.h>
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
 
 #include <algorithm>
 #include <atomic>
@@ -227,249 +226,269 @@ void wideRanges(const NeighborGrid& grid, const NeighborLists& lists, bool dense
     if (grid.cellStart[b] != grid.cellStart[b + 1]) ranges.insert(ranges.end(), {grid.cellStart[b], grid.cellStart[b + 1]});
 }
 
-}  // namespace
+// whether particles i and j are neighbours, |x_i - x_j| < h_ij (the lists' definition), from
+// d = x_i - x_j and their radii (a template on the lane type: the vector scan and the scalar one)
+template <class F>
+inline auto withinSupport(F dx, F dy, F dz, F hi, F hj) {
+  const F h = pairRadius(hi, hj);
+  return dx * dx + dy * dy + dz * dz < h * h;
+}
 
-void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
-                        NeighborLists& lists, uint32_t firstWater) {
+// one build of the lists (buildNeighborLists): its inputs, and its steps as member functions
+struct ListBuilder {
+  const std::vector<Vec3>& x;
+  const std::vector<float>& radius;
+  const NeighborGrid& grid;
+  NeighborLists& lists;
+  uint32_t firstWater;
+  float cs;               // the grid's cell size
+  bool parallel;
+  bool dense = false;     // the dense grid (buildDenseCells) or the hashed grid's buckets
+  const uint32_t* entries = nullptr;  // the candidates in cell order (lists.px .. ph: their positions, radii)
+  float hMax = 0.0f;      // the largest radius
+
+  void sortCandidates();
+  void findBig();
+  void scan(size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
+            std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) const;
+  void buildBigLists();
+  void invertBigLists();
+  void neighboursOf(size_t i, RangeCache& cache, std::vector<uint32_t>& cl, std::vector<uint32_t>& wa,
+                    uint32_t& nCloth, uint32_t& nWater) const;
+  void reserveIndex();
+  void fillLists();
+};
+
+// the candidates in the order of the dense grid's cells (or the hashed grid's buckets), with their
+// positions and radii in contiguous arrays in that order
+void ListBuilder::sortCandidates() {
   const size_t n = x.size();
-  lists.firstWater = firstWater;
-  lists.start.resize(n + 1);
-  lists.mid.resize(n);
-  lists.start[0] = 0;
-  // candidates read their position and radius from contiguous arrays in bucket order
-  lists.px.resize(n);
-  lists.py.resize(n);
-  lists.pz.resize(n);
-  lists.ph.resize(n);
-  float* px = lists.px.data();
-  float* py = lists.py.data();
-  float* pz = lists.pz.data();
-  float* ph = lists.ph.data();
-  const float cs = grid.cellSize;
-  const bool parallel = static_cast<int64_t>(n) >= kParallelGrain;
+  for (std::vector<float>* v : {&lists.px, &lists.py, &lists.pz, &lists.ph}) v->resize(n);
   // a dense grid over the particles' bounding box (cells of the same size, x fastest) when it has no
   // more than 8 cells a particle plus 2^20: then the three cells of a row around a particle are one range
   // of the sorted entries, 9 ranges of about 3 cells instead of 27 of one. Else the hashed grid's buckets
-  const bool dense = buildDenseCells(x, cs, lists);
+  dense = buildDenseCells(x, cs, lists);
   lists.dense = dense;
-  const uint32_t* entries = dense ? lists.denseEntries.data() : grid.cellEntries.data();
+  entries = dense ? lists.denseEntries.data() : grid.cellEntries.data();
   parallelFor(static_cast<int64_t>(n), [&](int64_t k) {
     const uint32_t j = entries[k];
-    px[k] = x[j].x();
-    py[k] = x[j].y();
-    pz[k] = x[j].z();
-    ph[k] = radius[j];
+    lists.px[k] = x[j].x();
+    lists.py[k] = x[j].y();
+    lists.pz[k] = x[j].z();
+    lists.ph[k] = radius[j];
   });
+}
 
-  // Particles whose support radius exceeds the cell size ("big": drips that grew while they hung, see
-  // neighborCellSize) are searched over every cell within their reach, and the others' candidates
-  // skip them: a big particle's pairs come from its own search and are handed to its neighbours'
-  // lists. One grown drip no longer makes every particle search cells of its size.
-  std::vector<uint32_t>& big = lists.big;
-  big.clear();
-  float hMax = 0.0f;
-  for (size_t i = 0; i < n; ++i) {
+// Particles whose support radius exceeds the cell size ("big": drips that grew while they hung, see
+// neighborCellSize) are searched over every cell within their reach, and the others' candidates
+// skip them: a big particle's pairs come from its own search and are handed to its neighbours'
+// lists. One grown drip no longer makes every particle search cells of its size.
+void ListBuilder::findBig() {
+  lists.big.clear();
+  hMax = 0.0f;
+  for (size_t i = 0; i < x.size(); ++i) {
     hMax = std::max(hMax, radius[i]);
-    if (radius[i] > cs) big.push_back(static_cast<uint32_t>(i));
+    if (radius[i] > cs) lists.big.push_back(static_cast<uint32_t>(i));
   }
+}
 
-  // the neighbours of i among the candidates of ranges [ranges[2r], ranges[2r + 1]) of the entries,
-  // cloth ones to cl[nCloth ..) and water ones to wa[nWater ..), in candidate order. Candidates with
-  // a radius above `cutoff` are skipped. Branch free: every candidate is written, the cursor advances
-  // only for neighbours (AVX-512: all of them to wa first, one store a vector, and the cloth ones
-  // moved to cl afterwards when there are any)
-  const auto scan = [&](size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
-                        std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) {
-    const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
-    uint32_t ncl = nCloth, nwa = nWater;
-    // locals, not the closure's references: the vector stores below may alias anything, and the
-    // compiler would load every pointer again after each of them
-    const float* const PX = px;
-    const float* const PY = py;
-    const float* const PZ = pz;
-    const float* const PH = ph;
-    const uint32_t* const E = entries;
-#if defined(__AVX512F__)
-    // every neighbour to wa in candidate order, then the cloth ones (if any) moved to cl, both kept in
-    // candidate order: the lists are the scalar loop's
-    __mmask16 anyCloth = 0;
-    const uint32_t nwa0 = nwa;
-    for (int r = 0; r < count; ++r) {
-      const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
-      if (nwa + (k1 - k0) + 16 > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + 16));  // + 16: whole-vector stores
-      uint32_t* pw = wa.data();
-      const __m512 vx = _mm512_set1_ps(xi), vy = _mm512_set1_ps(yi), vz = _mm512_set1_ps(zi);
-      const __m512 vh = _mm512_set1_ps(hi), half = _mm512_set1_ps(0.5f), vcut = _mm512_set1_ps(cutoff);
-      const __m512i self = _mm512_set1_epi32(static_cast<int>(i)), split = _mm512_set1_epi32(static_cast<int>(firstWater));
-      for (uint32_t k = k0; k < k1; k += 16) {
-        const __mmask16 lanes = k1 - k >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (k1 - k)) - 1u);
-        const __m512 dx = _mm512_sub_ps(vx, _mm512_maskz_loadu_ps(lanes, PX + k));
-        const __m512 dy = _mm512_sub_ps(vy, _mm512_maskz_loadu_ps(lanes, PY + k));
-        const __m512 dz = _mm512_sub_ps(vz, _mm512_maskz_loadu_ps(lanes, PZ + k));
-        const __m512 hj = _mm512_maskz_loadu_ps(lanes, PH + k);
-        const __m512 h = _mm512_mul_ps(half, _mm512_add_ps(vh, hj));
-        // (dx^2 + dy^2) + dz^2, rounded as the scalar expression (no FMA)
-        const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
-        const __m512i j = _mm512_maskz_loadu_epi32(lanes, E + k);
-        const __mmask16 in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(h, h), _CMP_LT_OQ) &
-                             _mm512_cmp_ps_mask(hj, vcut, _CMP_LE_OQ) & _mm512_cmpneq_epi32_mask(j, self);
-        anyCloth |= in & _mm512_cmplt_epu32_mask(j, split);
-        // compress in a register and store all 16 lanes (the list has room): a compressing store
-        // to memory is microcoded on some processors
-        _mm512_storeu_si512(pw + nwa, _mm512_maskz_compress_epi32(in, j));
-        nwa += static_cast<uint32_t>(__builtin_popcount(in));
-      }
+// the neighbours of i among the candidates of ranges [ranges[2r], ranges[2r + 1]) of the entries,
+// cloth ones to cl[nCloth ..) and water ones to wa[nWater ..), in candidate order. Candidates with
+// a radius above `cutoff` are skipped. Branch free: every candidate is written, the cursor advances
+// only for neighbours (wide lanes: all of them to wa first, one store a vector, and the cloth ones
+// moved to cl afterwards when there are any)
+void ListBuilder::scan(size_t i, const uint32_t* ranges, int count, float cutoff, std::vector<uint32_t>& cl,
+                       std::vector<uint32_t>& wa, uint32_t& nCloth, uint32_t& nWater) const {
+  const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
+  uint32_t ncl = nCloth, nwa = nWater;
+  // locals, not members: the vector stores below may alias anything, and the compiler would load
+  // every pointer again after each of them
+  const float* const PX = lists.px.data();
+  const float* const PY = lists.py.data();
+  const float* const PZ = lists.pz.data();
+  const float* const PH = lists.ph.data();
+  const uint32_t* const E = entries;
+#if SOAK_SIMD_WIDE
+  // every neighbour to wa in candidate order, then the cloth ones (if any) moved to cl, both kept in
+  // candidate order: the lists are the scalar loop's
+  using simd::FloatW;
+  simd::MaskW anyCloth{0};
+  const uint32_t nwa0 = nwa;
+  const FloatW vx = xi, vy = yi, vz = zi, vh = hi, vcut = cutoff;
+  const simd::UintW self = simd::splat(static_cast<uint32_t>(i)), split = simd::splat(firstWater);
+  for (int r = 0; r < count; ++r) {
+    const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
+    if (nwa + (k1 - k0) + simd::kLanes > wa.size()) wa.resize(2 * (nwa + (k1 - k0) + simd::kLanes));  // whole-vector stores
+    uint32_t* pw = wa.data();
+    for (uint32_t k = k0; k < k1; k += simd::kLanes) {
+      const simd::MaskW lanes = simd::firstLanes(k1 - k);
+      const FloatW hj = simd::load(PH + k, lanes);
+      const simd::UintW j = simd::load(E + k, lanes);
+      const simd::MaskW in = lanes & withinSupport(vx - simd::load(PX + k, lanes), vy - simd::load(PY + k, lanes),
+                                                   vz - simd::load(PZ + k, lanes), vh, hj) &
+                             (hj <= vcut) & (j != self);
+      anyCloth |= in & (j < split);
+      simd::storeCompressed(pw + nwa, in, j);
+      nwa += static_cast<uint32_t>(simd::count(in));
     }
-    if (anyCloth) {
-      if (ncl + (nwa - nwa0) > cl.size()) cl.resize(2 * (ncl + (nwa - nwa0)));
-      uint32_t keep = nwa0;
-      for (uint32_t e = nwa0; e < nwa; ++e) {
-        const uint32_t j = wa[e];
-        if (j < firstWater)
-          cl[ncl++] = j;
-        else
-          wa[keep++] = j;
-      }
-      nwa = keep;
+  }
+  if (simd::any(anyCloth)) {
+    if (ncl + (nwa - nwa0) > cl.size()) cl.resize(2 * (ncl + (nwa - nwa0)));
+    uint32_t keep = nwa0;
+    for (uint32_t e = nwa0; e < nwa; ++e) {
+      const uint32_t j = wa[e];
+      if (j < firstWater)
+        cl[ncl++] = j;
+      else
+        wa[keep++] = j;
     }
+    nwa = keep;
+  }
 #else
-    for (int r = 0; r < count; ++r) {
-      const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
-      if (ncl + (k1 - k0) > cl.size()) cl.resize(2 * (ncl + (k1 - k0)));
-      if (nwa + (k1 - k0) > wa.size()) wa.resize(2 * (nwa + (k1 - k0)));
-      uint32_t* pc = cl.data();
-      uint32_t* pw = wa.data();
-      for (uint32_t k = k0; k < k1; ++k) {
-        const float dx = xi - PX[k], dy = yi - PY[k], dz = zi - PZ[k];
-        const float h = 0.5f * (hi + PH[k]);
-        const uint32_t j = E[k];
-        const uint32_t in = (dx * dx + dy * dy + dz * dz < h * h) & (PH[k] <= cutoff) & (j != static_cast<uint32_t>(i));
-        const uint32_t isCloth = j < firstWater;
-        pc[ncl] = j;
-        pw[nwa] = j;
-        ncl += in & isCloth;
-        nwa += in & (isCloth ^ 1u);
-      }
-    }
-#endif
-    nCloth = ncl;
-    nWater = nwa;
-  };
-
-  // each big particle's list (cloth part first), from every cell within (h_i + hMax) / 2, all candidates
-  std::vector<std::vector<uint32_t>>& bigLists = lists.bigLists;
-  std::vector<uint32_t>& bigCloth = lists.bigCloth;
-  bigLists.resize(big.size());
-  bigCloth.resize(big.size());
-  if (!big.empty()) {
-#pragma omp parallel if (parallel && big.size() > 1)
-    {
-      std::vector<uint32_t> ranges, buckets, cl(256), wa(256);
-#pragma omp for schedule(dynamic, 1)
-      for (int64_t b = 0; b < static_cast<int64_t>(big.size()); ++b) {
-        const size_t i = big[static_cast<size_t>(b)];
-        wideRanges(grid, lists, dense, x[i], cs, 0.5f * (radius[i] + hMax) * 1.001f, ranges, buckets);  // margin for rounding
-        uint32_t ncl = 0, nwa = 0;
-        scan(i, ranges.data(), static_cast<int>(ranges.size() / 2), std::numeric_limits<float>::infinity(), cl, wa, ncl, nwa);
-        std::vector<uint32_t>& out = bigLists[static_cast<size_t>(b)];
-        out.assign(cl.data(), cl.data() + ncl);
-        out.insert(out.end(), wa.data(), wa.data() + nwa);
-        bigCloth[static_cast<size_t>(b)] = ncl;
-      }
+  for (int r = 0; r < count; ++r) {
+    const uint32_t k0 = ranges[2 * r], k1 = ranges[2 * r + 1];
+    if (ncl + (k1 - k0) > cl.size()) cl.resize(2 * (ncl + (k1 - k0)));
+    if (nwa + (k1 - k0) > wa.size()) wa.resize(2 * (nwa + (k1 - k0)));
+    uint32_t* pc = cl.data();
+    uint32_t* pw = wa.data();
+    for (uint32_t k = k0; k < k1; ++k) {
+      const uint32_t j = E[k];
+      const uint32_t in = withinSupport(xi - PX[k], yi - PY[k], zi - PZ[k], hi, PH[k]) & (PH[k] <= cutoff) &
+                          (j != static_cast<uint32_t>(i));
+      const uint32_t isCloth = j < firstWater;
+      pc[ncl] = j;
+      pw[nwa] = j;
+      ncl += in & isCloth;
+      nwa += in & (isCloth ^ 1u);
     }
   }
-  // the big neighbours of every other particle, by ascending index: the lists above turned around
+#endif
+  nCloth = ncl;
+  nWater = nwa;
+}
+
+// each big particle's list (cloth part first), from every cell within (h_i + hMax) / 2, all candidates
+void ListBuilder::buildBigLists() {
+  const std::vector<uint32_t>& big = lists.big;
+  lists.bigLists.resize(big.size());
+  lists.bigCloth.resize(big.size());
+  if (big.empty()) return;
+#pragma omp parallel if (parallel && big.size() > 1)
+  {
+    std::vector<uint32_t> ranges, buckets, cl(256), wa(256);
+#pragma omp for schedule(dynamic, 1)
+    for (int64_t b = 0; b < static_cast<int64_t>(big.size()); ++b) {
+      const size_t i = big[static_cast<size_t>(b)];
+      wideRanges(grid, lists, dense, x[i], cs, 0.5f * (radius[i] + hMax) * 1.001f, ranges, buckets);  // margin for rounding
+      uint32_t ncl = 0, nwa = 0;
+      scan(i, ranges.data(), static_cast<int>(ranges.size() / 2), std::numeric_limits<float>::infinity(), cl, wa, ncl, nwa);
+      std::vector<uint32_t>& out = lists.bigLists[static_cast<size_t>(b)];
+      out.assign(cl.data(), cl.data() + ncl);
+      out.insert(out.end(), wa.data(), wa.data() + nwa);
+      lists.bigCloth[static_cast<size_t>(b)] = ncl;
+    }
+  }
+}
+
+// the big neighbours of every other particle, by ascending index: the big lists turned around
+void ListBuilder::invertBigLists() {
+  const size_t n = x.size();
   std::vector<uint32_t>& extraStart = lists.bigOfStart;
   std::vector<uint32_t>& extra = lists.bigOf;
   extraStart.clear();
   extra.clear();
-  if (!big.empty()) {
-    extraStart.assign(n + 1, 0);
-    for (size_t b = 0; b < big.size(); ++b)
-      for (const uint32_t j : bigLists[b])
-        if (radius[j] <= cs) ++extraStart[j + 1];
-    for (size_t i = 0; i < n; ++i) extraStart[i + 1] += extraStart[i];
-    extra.resize(extraStart[n]);
-    std::vector<uint32_t> cursor(extraStart.begin(), extraStart.end() - 1);
-    for (size_t b = 0; b < big.size(); ++b)
-      for (const uint32_t j : bigLists[b])
-        if (radius[j] <= cs) extra[cursor[j]++] = big[b];
+  if (lists.big.empty()) return;
+  extraStart.assign(n + 1, 0);
+  for (size_t b = 0; b < lists.big.size(); ++b)
+    for (const uint32_t j : lists.bigLists[b])
+      if (radius[j] <= cs) ++extraStart[j + 1];
+  for (size_t i = 0; i < n; ++i) extraStart[i + 1] += extraStart[i];
+  extra.resize(extraStart[n]);
+  std::vector<uint32_t> cursor(extraStart.begin(), extraStart.end() - 1);
+  for (size_t b = 0; b < lists.big.size(); ++b)
+    for (const uint32_t j : lists.bigLists[b])
+      if (radius[j] <= cs) extra[cursor[j]++] = lists.big[b];
+}
+
+// the neighbours of i, cloth ones to cl[0 .. nCloth) and water ones to wa[0 .. nWater), in a
+// fixed order. Cells the particle's reach does not touch are skipped.
+void ListBuilder::neighboursOf(size_t i, RangeCache& cache, std::vector<uint32_t>& cl, std::vector<uint32_t>& wa,
+                               uint32_t& nCloth, uint32_t& nWater) const {
+  const float hi = radius[i];
+  if (hi > cs) {  // a big particle: its list is made
+    const std::vector<uint32_t>& big = lists.big;
+    const size_t b = static_cast<size_t>(std::lower_bound(big.begin(), big.end(), static_cast<uint32_t>(i)) - big.begin());
+    const std::vector<uint32_t>& own = lists.bigLists[b];
+    nCloth = lists.bigCloth[b];
+    nWater = static_cast<uint32_t>(own.size()) - nCloth;
+    if (nCloth > cl.size()) cl.resize(nCloth);
+    if (nWater > wa.size()) wa.resize(nWater);
+    std::copy(own.begin(), own.begin() + nCloth, cl.begin());
+    std::copy(own.begin() + nCloth, own.end(), wa.begin());
+    return;
   }
+  const float reach = 0.5f * (hi + cs) * 1.001f, reach2 = reach * reach;  // margin for rounding
+  uint32_t ranges[27][2];
+  int count = 0;
+  if (dense) {
+    count = denseRowRanges(lists, x[i], cs, reach2, ranges);
+  } else {
+    const Eigen::Vector3i c = grid.cellOf(x[i]);
+    cache.lookup(grid, c);
+    const float f[3] = {x[i].x() - cs * c.x(), x[i].y() - cs * c.y(), x[i].z() - cs * c.z()};
+    for (int r = 0; r < cache.count; ++r) {
+      if (!RangeCache::touches(cache.offset[r], f, cs, reach2)) continue;
+      ranges[count][0] = cache.ranges[r][0];
+      ranges[count][1] = cache.ranges[r][1];
+      ++count;
+    }
+  }
+  nCloth = nWater = 0;
+  scan(i, &ranges[0][0], count, cs, cl, wa, nCloth, nWater);
+  // then its big neighbours, after the others of its kind
+  for (uint32_t e = lists.bigOf.empty() ? 0 : lists.bigOfStart[i], e1 = lists.bigOf.empty() ? 0 : lists.bigOfStart[i + 1];
+       e < e1; ++e) {
+    const uint32_t j = lists.bigOf[e];
+    std::vector<uint32_t>& to = j < firstWater ? cl : wa;
+    uint32_t& at = j < firstWater ? nCloth : nWater;
+    if (at + 1 > to.size()) to.resize(2 * (at + 1));
+    to[at++] = j;
+  }
+}
 
-  // the neighbours of i, cloth ones to cl[0 .. nCloth) and water ones to wa[0 .. nWater), in a
-  // fixed order. Cells the particle's reach does not touch are skipped.
-  const auto gather = [&](size_t i, RangeCache& cache, std::vector<uint32_t>& cl, std::vector<uint32_t>& wa,
-                          uint32_t& nCloth, uint32_t& nWater) {
-    const float xi = x[i].x(), yi = x[i].y(), zi = x[i].z(), hi = radius[i];
-    if (hi > cs) {  // a big particle: its list is made
-      const size_t b = static_cast<size_t>(std::lower_bound(big.begin(), big.end(), static_cast<uint32_t>(i)) - big.begin());
-      const std::vector<uint32_t>& own = bigLists[b];
-      nCloth = bigCloth[b];
-      nWater = static_cast<uint32_t>(own.size()) - nCloth;
-      if (nCloth > cl.size()) cl.resize(nCloth);
-      if (nWater > wa.size()) wa.resize(nWater);
-      std::copy(own.begin(), own.begin() + nCloth, cl.begin());
-      std::copy(own.begin() + nCloth, own.end(), wa.begin());
-      return;
-    }
-    const float reach = 0.5f * (hi + cs) * 1.001f, reach2 = reach * reach;  // margin for rounding
-    uint32_t ranges[27][2];
-    int count = 0;
-    if (dense) {
-      count = denseRowRanges(lists, x[i], cs, reach2, ranges);
-    } else {
-      const Eigen::Vector3i c = grid.cellOf(x[i]);
-      cache.lookup(grid, c);
-      const float f[3] = {xi - cs * c.x(), yi - cs * c.y(), zi - cs * c.z()};
-      for (int r = 0; r < cache.count; ++r) {
-        if (!RangeCache::touches(cache.offset[r], f, cs, reach2)) continue;
-        ranges[count][0] = cache.ranges[r][0];
-        ranges[count][1] = cache.ranges[r][1];
-        ++count;
-      }
-    }
-    nCloth = nWater = 0;
-    scan(i, &ranges[0][0], count, cs, cl, wa, nCloth, nWater);
-    if (extra.empty()) return;
-    // then its big neighbours, after the others of its kind
-    for (uint32_t e = extraStart[i]; e < extraStart[i + 1]; ++e) {
-      const uint32_t j = extra[e];
-      std::vector<uint32_t>& to = j < firstWater ? cl : wa;
-      uint32_t& at = j < firstWater ? nCloth : nWater;
-      if (at + 1 > to.size()) to.resize(2 * (at + 1));
-      to[at++] = j;
-    }
-  };
-
-  // room for the lists: last build's total and an eighth (exact on the first build, from a count
-  // pass), so the index array is not reallocated while it is filled. The room is kept while it holds
-  // the last total and a sixteenth: asking for last + last / 8 each time reallocated the array (fresh
-  // pages, touched serially) whenever the total had grown by one entry
+// room for the lists: last build's total and an eighth (exact on the first build, from a count
+// pass), so the index array is not reallocated while it is filled. The room is kept while it holds
+// the last total and a sixteenth: asking for last + last / 8 each time reallocated the array (fresh
+// pages, touched serially) whenever the total had grown by one entry
+void ListBuilder::reserveIndex() {
   const size_t last = lists.index.size();
   lists.index.clear();
   if (last > 0) {
     if (lists.index.capacity() < last + last / 16) lists.index.reserve(last + last / 8);
-  } else {
-    size_t total = 0;
-#pragma omp parallel if (parallel) reduction(+ : total)
-    {
-      RangeCache cache;
-      std::vector<uint32_t> cl(256), wa(256);
-#pragma omp for schedule(static)
-      for (int64_t i = 0; i < static_cast<int64_t>(n); ++i) {
-        uint32_t ncl, nwa;
-        gather(static_cast<size_t>(i), cache, cl, wa, ncl, nwa);
-        total += ncl + nwa;
-      }
-    }
-    lists.index.reserve(total + total / 8);
+    return;
   }
+  size_t total = 0;
+#pragma omp parallel if (parallel) reduction(+ : total)
+  {
+    RangeCache cache;
+    std::vector<uint32_t> cl(256), wa(256);
+#pragma omp for schedule(static)
+    for (int64_t i = 0; i < static_cast<int64_t>(x.size()); ++i) {
+      uint32_t ncl, nwa;
+      neighboursOf(static_cast<size_t>(i), cache, cl, wa, ncl, nwa);
+      total += ncl + nwa;
+    }
+  }
+  lists.index.reserve(total + total / 8);
+}
 
-  // one distance pass in chunks of particles that the threads take as they come (a folded or bunched
-  // part of the sheet has many more neighbours than the rest, so equal halves were unequal work): each
-  // chunk gathers into its own buffer, then the buffers are copied to the list in particle order, so
-  // the lists do not depend on which thread did what. Rounds of kRound chunks: the buffers hold one
-  // round, not a copy of the lists.
+// one distance pass in chunks of particles that the threads take as they come (a folded or bunched
+// part of the sheet has many more neighbours than the rest, so equal halves were unequal work): each
+// chunk gathers into its own buffer, then the buffers are copied to the list in particle order, so
+// the lists do not depend on which thread did what. Rounds of kRound chunks: the buffers hold one
+// round, not a copy of the lists.
+void ListBuilder::fillLists() {
+  const size_t n = x.size();
   constexpr size_t kChunk = 256, kRound = 64;
   uint32_t* start = lists.start.data();
   uint32_t* mid = lists.mid.data();
@@ -489,7 +508,7 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
       chunkRange(c, lo, hi);
       for (size_t i = lo; i < hi; ++i) {
         uint32_t ncl, nwa;
-        gather(i, t.cache, t.cl, t.wa, ncl, nwa);
+        neighboursOf(i, t.cache, t.cl, t.wa, ncl, nwa);
         start[i + 1] = ncl + nwa;  // a count until the offsets are known
         mid[i] = ncl;
         out.insert(out.end(), t.cl.data(), t.cl.data() + ncl);
@@ -515,6 +534,24 @@ void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& ra
     };
     orderedChunks(chunks, lists.chunkBuffers, offset, start[r0], parallel, [] { return Local(); }, fill, size, place);
   }
+}
+
+}  // namespace
+
+void buildNeighborLists(const std::vector<Vec3>& x, const std::vector<float>& radius, const NeighborGrid& grid,
+                        NeighborLists& lists, uint32_t firstWater) {
+  const size_t n = x.size();
+  lists.firstWater = firstWater;
+  lists.start.resize(n + 1);
+  lists.mid.resize(n);
+  lists.start[0] = 0;
+  ListBuilder b{x, radius, grid, lists, firstWater, grid.cellSize, static_cast<int64_t>(n) >= kParallelGrain};
+  b.sortCandidates();
+  b.findBig();
+  b.buildBigLists();
+  b.invertBigLists();
+  b.reserveIndex();
+  b.fillLists();
 }
 
 }  // namespace soak

@@ -4,10 +4,9 @@
 
 #include <algorithm>
 #include <limits>
+#include "core/simd.hpp"
+
 #include <omp.h>
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
 
 namespace soak {
 
@@ -45,11 +44,15 @@ Vec3 closestBarycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3&
   return {1 - v - w, v, w};
 }
 
-#if defined(__AVX512F__)
-// min and max by compare and blend (_mm512_min_ps / _mm512_max_ps draw a false undefined-operand warning)
-inline __m512 minPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp_ps_mask(y, x, _CMP_LT_OQ), x, y); }
-inline __m512 maxPs(__m512 x, __m512 y) { return _mm512_mask_blend_ps(_mm512_cmp_ps_mask(x, y, _CMP_LT_OQ), x, y); }
-#endif
+// whether a point p is within r of the segment a -> a + b, from p - a = (px, py, pz), b and 1 / |b|^2
+// (0 for a point): the closest point is a + u b, u = clamp((p - a) . b / |b|^2, 0, 1). A template on
+// the lane type: the vector walk and the scalar one
+template <class F>
+inline auto nearSegment(F px, F py, F pz, F bx, F by, F bz, F invLen2, F r) {
+  const F u = simd::clamp((px * bx + py * by + pz * bz) * invLen2, F(0.0f), F(1.0f));
+  const F dx = px - u * bx, dy = py - u * by, dz = pz - u * bz;
+  return dx * dx + dy * dy + dz * dz < r * r;
+}
 
 // how far outside a triangle (in barycentric units) a point still counts as on its face
 constexpr float kFaceTolerance = 1e-3f;
@@ -193,34 +196,22 @@ void walkNearPath(const ClothBoxGrid& grid, const Vec3& a, const Vec3& ab, float
       for (int cy = c0.y(); cy <= c1.y(); ++cy) {
         const uint32_t e0 = cellStart[grid.index(c0.x(), cy, cz)], e1 = cellStart[grid.index(c1.x(), cy, cz) + 1];
         uint32_t e = e0;
-#if defined(__AVX512F__)
-        // 16 slots of the row at a time; the few within reach are taken in slot order
-        const __m512 vax = _mm512_set1_ps(a.x()), vay = _mm512_set1_ps(a.y()), vaz = _mm512_set1_ps(a.z());
-        const __m512 vbx = _mm512_set1_ps(ab.x()), vby = _mm512_set1_ps(ab.y()), vbz = _mm512_set1_ps(ab.z());
-        const __m512 vinv = _mm512_set1_ps(invLen2), vreach = _mm512_set1_ps(reachQ);
-        const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
-        for (; e < e1; e += 16) {
-          const __mmask16 lanes = e1 - e >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (e1 - e)) - 1u);
-          const __m512 jx = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, PX + e), vax);
-          const __m512 jy = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, PY + e), vay);
-          const __m512 jz = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, PZ + e), vaz);
-          const __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(jx, vbx), _mm512_mul_ps(jy, vby)), _mm512_mul_ps(jz, vbz));
-          const __m512 u = minPs(maxPs(_mm512_mul_ps(dot, vinv), zero), one);
-          const __m512 dx = _mm512_sub_ps(jx, _mm512_mul_ps(u, vbx)), dy = _mm512_sub_ps(jy, _mm512_mul_ps(u, vby)),
-                       dz = _mm512_sub_ps(jz, _mm512_mul_ps(u, vbz));
-          const __m512 d2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)), _mm512_mul_ps(dz, dz));
-          const __m512 r = minPs(vreach, _mm512_maskz_loadu_ps(lanes, PR + e));
-          for (uint32_t in = _mm512_mask_cmp_ps_mask(lanes, d2, _mm512_mul_ps(r, r), _CMP_LT_OQ); in; in &= in - 1)
-            take(entry[e + static_cast<uint32_t>(__builtin_ctz(in))]);
+#if SOAK_SIMD_WIDE
+        // kLanes slots of the row at a time; the few within reach are taken in slot order
+        using simd::FloatW;
+        const FloatW vax = a.x(), vay = a.y(), vaz = a.z(), vbx = ab.x(), vby = ab.y(), vbz = ab.z();
+        const FloatW vinv = invLen2, vreach = reachQ;
+        for (; e < e1; e += simd::kLanes) {
+          const simd::MaskW lanes = simd::firstLanes(e1 - e);
+          const FloatW r = simd::min(vreach, simd::load(PR + e, lanes));
+          const simd::MaskW in = lanes & nearSegment(simd::load(PX + e, lanes) - vax, simd::load(PY + e, lanes) - vay,
+                                                     simd::load(PZ + e, lanes) - vaz, vbx, vby, vbz, vinv, r);
+          for (uint32_t bits = simd::bits(in); bits; bits &= bits - 1) take(entry[e + static_cast<uint32_t>(__builtin_ctz(bits))]);
         }
 #endif
-        for (; e < e1; ++e) {  // the same arithmetic, one slot at a time
-          const float jx = PX[e] - a.x(), jy = PY[e] - a.y(), jz = PZ[e] - a.z();
-          const float u = std::min(std::max((jx * ab.x() + jy * ab.y() + jz * ab.z()) * invLen2, 0.0f), 1.0f);
-          const float dx = jx - u * ab.x(), dy = jy - u * ab.y(), dz = jz - u * ab.z();
-          const float r = std::min(reachQ, PR[e]);
-          if (dx * dx + dy * dy + dz * dz < r * r) take(entry[e]);
-        }
+        for (; e < e1; ++e)  // one slot at a time
+          if (nearSegment(PX[e] - a.x(), PY[e] - a.y(), PZ[e] - a.z(), ab.x(), ab.y(), ab.z(), invLen2, std::min(reachQ, PR[e])))
+            take(entry[e]);
       }
   }
 }
