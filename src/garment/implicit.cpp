@@ -81,19 +81,15 @@ GarmentPiece buildGarmentPiece(const Model& model, int piece, const GarmentParam
   return g;
 }
 
-ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
-                           const std::vector<ColliderPose>& poses, std::span<const float> wetStart,
-                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
-  ImplicitStats stats;
-  const SpringSet& sp = g.springs;
-  const int n = g.count, ns = sp.size();
-  const size_t first = static_cast<size_t>(g.firstParticle);
-  const double hd = h;
-  const double alpha = params.rayleighAlpha, beta = params.rayleighBeta;
-  const double kScale = hd * beta + hd * hd;  // coefficient of K in A: h beta (damping) + h^2 (df/dx)
-  const Vec3d gravity = model.solver.gravity.cast<double>();
+namespace {
 
-  // forces and stiffness per spring (Eq. 12-13), each spring writes only its own slot
+// forces and stiffness per spring (Eq. 12-13), each spring writes only its own slot; the strain range
+// of the stretch springs to stats
+void springForces(const GarmentPiece& g, const GarmentParams& params, const Particles& p, ImplicitScratch& w,
+                  ImplicitStats& stats) {
+  const SpringSet& sp = g.springs;
+  const int ns = sp.size();
+  const size_t first = static_cast<size_t>(g.firstParticle);
   w.springForce.resize(static_cast<size_t>(ns));
   w.springStiffness.resize(static_cast<size_t>(ns));
   w.strain.resize(static_cast<size_t>(ns));
@@ -106,8 +102,14 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     stats.minStrain = *lo;
     stats.maxStrain = *hi;
   }
+}
 
-  // constrained rows: pinned vertices stay (dv = -v0), disturbed vertices reach their target
+// constrained rows: pinned vertices stay (dv = -v0, constrained 1), disturbed vertices reach their
+// target (constrained 2)
+void constrainRows(const Model& model, const GarmentPiece& g, const std::vector<PositionConstraint>& constraints,
+                   const Particles& p, double hd, ImplicitScratch& w, ImplicitStats& stats) {
+  const int n = g.count;
+  const size_t first = static_cast<size_t>(g.firstParticle);
   w.constrained.assign(static_cast<size_t>(n), 0);
   w.dv.assign(static_cast<size_t>(n), Vec3d::Zero());
   for (int v = 0; v < n; ++v)
@@ -122,14 +124,22 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     w.dv[c.vertex] = ((c.target - p.x[i]).cast<double>() / hd) - p.v[i].cast<double>();
   }
   for (uint8_t c : w.constrained) stats.constrainedVertices += c ? 1 : 0;
+}
 
-  // A = M (1 + h alpha) + (h beta + h^2) K, b = h (f0 + h df/dx v0), gathered per row (Eq. 3-4)
-  w.A.rows = n;
+// A = M (1 + h alpha) + (h beta + h^2) K, b = h (f0 + h df/dx v0), gathered per row (Eq. 3-4)
+void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentParams& params, const Particles& p,
+                    double hd, ImplicitScratch& w) {
+  const SpringSet& sp = g.springs;
+  const size_t first = static_cast<size_t>(g.firstParticle);
+  const double alpha = params.rayleighAlpha, beta = params.rayleighBeta;
+  const double kScale = hd * beta + hd * hd;  // coefficient of K in A: h beta (damping) + h^2 (df/dx)
+  const Vec3d gravity = model.solver.gravity.cast<double>();
+  w.A.rows = g.count;
   w.A.rowStart = g.rowStart;
   w.A.col = g.col;
   w.A.block.resize(g.col.size());
-  w.rhs.resize(static_cast<size_t>(n));
-  parallelFor(n, [&](int64_t v) {
+  w.rhs.resize(static_cast<size_t>(g.count));
+  parallelFor(g.count, [&](int64_t v) {
     const size_t i = first + static_cast<size_t>(v);
     const double m = p.mass[i];
     const Vec3d v0 = p.v[i].cast<double>();
@@ -150,22 +160,19 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     // f0 includes the stiffness damping -beta K v0; h df/dx v0 = -h K v0
     w.rhs[v] = hd * (f - (beta + hd) * kv);
   });
+}
 
-  CgOptions opt;
-  opt.tolerance = params.cgTolerance;
-  opt.maxIterations = params.cgMaxIterations;
-  const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg);
-  stats.cgIterations = cg.iterations;
-  stats.cgResidual = cg.residual;
-  stats.converged = cg.converged;
-  stats.breakdown = cg.breakdown;
-
-  // v1 = v0 + dv, x1 = x0 + h v1; then contact with the colliders at time + h
+// v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then contact with the colliders at time + h, with
+// the fabric's wet friction; marks the vertices in contact with 3 in w.constrained
+void integrateWithContact(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
+                          const std::vector<ColliderPose>& poses, std::span<const float> wetStart, Particles& p,
+                          ImplicitScratch& w) {
+  const size_t first = static_cast<size_t>(g.firstParticle);
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
-  const double tEnd = time + hd;
+  const double tEnd = time + static_cast<double>(h);
   std::vector<uint8_t>& touched = w.constrained;  // reused: 3 = in contact this step
-  parallelFor(n, [&](int64_t v) {
+  parallelFor(g.count, [&](int64_t v) {
     const size_t i = first + static_cast<size_t>(v);
     if (w.constrained[v] == 1) {  // pinned: never moves
       p.xPred[i] = p.x[i];
@@ -200,7 +207,28 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     p.v[i] = vel;
     if (contact) touched[v] = 3;
   });
-  for (uint8_t c : touched) stats.contacts += c == 3 ? 1 : 0;
+}
+
+}  // namespace
+
+ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
+                           const std::vector<ColliderPose>& poses, std::span<const float> wetStart,
+                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
+  ImplicitStats stats;
+  const double hd = h;
+  springForces(g, params, p, w, stats);
+  constrainRows(model, g, constraints, p, hd, w, stats);
+  assembleSystem(model, g, params, p, hd, w);
+  CgOptions opt;
+  opt.tolerance = params.cgTolerance;
+  opt.maxIterations = params.cgMaxIterations;
+  const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg);
+  stats.cgIterations = cg.iterations;
+  stats.cgResidual = cg.residual;
+  stats.converged = cg.converged;
+  stats.breakdown = cg.breakdown;
+  integrateWithContact(model, g, params, time, h, poses, wetStart, p, w);
+  for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;
   return stats;
 }
 

@@ -93,28 +93,88 @@ int chooseDisturbance(const Vec3& a, const SphereIntersection& hits, const std::
   return coin & 1;
 }
 
+namespace {
+
+// one piece's springs at the current positions, as the disturbance model reads them
+struct SpringView {
+  const Model& model;
+  const SpringSet& springs;
+  const Particles& p;
+  int first;       // the piece's first particle
+  int stretchEnd;  // springs [0, stretchEnd) are the stretch springs
+  const Vec3& pos(int v) const { return p.x[static_cast<size_t>(first + v)]; }
+  bool pinned(int v) const { return model.clothPinned[static_cast<size_t>(first + v)] != 0; }
+  float strain(int s) const {
+    const float l0 = springs.restLength[s];
+    return ((pos(springs.ids[s][1]) - pos(springs.ids[s][0])).norm() - l0) / l0;
+  }
+  // stretch springs of v, in spring order
+  void stretchOf(int v, std::vector<int>& list) const {
+    list.clear();
+    for (int k = springs.vertexStart[v]; k < springs.vertexStart[v + 1]; ++k)
+      if (springs.vertexSpring[k] < stretchEnd) list.push_back(springs.vertexSpring[k]);
+  }
+  float meanStrain(int v, std::vector<int>& list) const {
+    stretchOf(v, list);
+    float sum = 0.0f;
+    for (int s : list) sum += strain(s);
+    return list.empty() ? 0.0f : sum / static_cast<float>(list.size());
+  }
+};
+
+// the most compressed stretch spring with both ends in subdomain k (lowest index on ties), compressed
+// beyond the threshold; -1 if none
+int mostCompressedSpring(const SpringView& view, const std::vector<int>& dom, int k, const std::vector<int>& owner,
+                         float threshold, std::vector<int>& list) {
+  const SpringSet& springs = view.springs;
+  int best = -1;
+  float bestEps = -threshold;
+  for (int v : dom) {
+    view.stretchOf(v, list);
+    for (int s : list) {
+      if (owner[springs.ids[s][0]] != k || owner[springs.ids[s][1]] != k) continue;
+      const float e = view.strain(s);
+      if (e < bestEps || (e == bestEps && best >= 0 && s < best)) {
+        best = s;
+        bestEps = e;
+      }
+    }
+  }
+  return best;
+}
+
+// C, D of Eq. 25: A's other stretch springs (not `best`, whose other end is B), most compressed first,
+// with B, C, D not collinear; false if there are no two such
+bool sideSprings(const SpringView& view, int a, int b, int best, std::vector<int>& list, int& sc, int& sd) {
+  const SpringSet& springs = view.springs;
+  view.stretchOf(a, list);
+  std::vector<std::pair<float, int>> others;
+  for (int s : list)
+    if (s != best) others.push_back({view.strain(s), s});
+  std::sort(others.begin(), others.end());
+  const float l0ab = springs.restLength[best];
+  for (size_t u = 0; u < others.size(); ++u)
+    for (size_t w = u + 1; w < others.size(); ++w) {
+      const Vec3 c = view.pos(springs.other(others[u].second, a)), d = view.pos(springs.other(others[w].second, a));
+      if ((c - view.pos(b)).cross(d - view.pos(b)).norm() > 0.05f * l0ab * l0ab) {
+        sc = others[u].second;
+        sd = others[w].second;
+        return true;
+      }
+    }
+  return false;
+}
+
+}  // namespace
+
 std::vector<PositionConstraint> computeDisturbances(const Model& model, int piece, const SpringSet& springs,
                                                     const std::vector<std::vector<int>>& subdomains,
                                                     const Particles& p, const std::vector<ColliderPose>& poses,
                                                     const WrinkleParams& params, uint64_t stepIndex) {
   std::vector<PositionConstraint> out;
   if (!params.enabled || params.interval < 1 || stepIndex % static_cast<uint64_t>(params.interval) != 0) return out;
-  const ClothPiece& pc = model.pieces[static_cast<size_t>(piece)];
-  const int first = pc.firstParticle;
+  const SpringView view{model, springs, p, model.pieces[static_cast<size_t>(piece)].firstParticle, springs.kindStart[1]};
   const float margin = contactMargin(model, static_cast<int32_t>(piece + 1));
-  const int stretchEnd = springs.kindStart[1];
-  auto pos = [&](int v) -> const Vec3& { return p.x[static_cast<size_t>(first + v)]; };
-  auto pinned = [&](int v) { return model.clothPinned[static_cast<size_t>(first + v)] != 0; };
-  auto strain = [&](int s) {
-    const float l0 = springs.restLength[s];
-    return ((pos(springs.ids[s][1]) - pos(springs.ids[s][0])).norm() - l0) / l0;
-  };
-  // stretch springs of v, in spring order
-  auto stretchOf = [&](int v, std::vector<int>& list) {
-    list.clear();
-    for (int k = springs.vertexStart[v]; k < springs.vertexStart[v + 1]; ++k)
-      if (springs.vertexSpring[k] < stretchEnd) list.push_back(springs.vertexSpring[k]);
-  };
   std::vector<int> owner(static_cast<size_t>(springs.numVertices), -1);
   for (size_t k = 0; k < subdomains.size(); ++k)
     for (int v : subdomains[k]) owner[static_cast<size_t>(v)] = static_cast<int>(k);
@@ -125,64 +185,30 @@ std::vector<PositionConstraint> computeDisturbances(const Model& model, int piec
     if (dom.empty()) continue;
     // near equilibrium: the system energy (here the RMS speed) is low enough
     double v2 = 0.0;
-    for (int v : dom) v2 += p.v[static_cast<size_t>(first + v)].squaredNorm();
+    for (int v : dom) v2 += p.v[static_cast<size_t>(view.first + v)].squaredNorm();
     if (std::sqrt(v2 / static_cast<double>(dom.size())) > params.equilibriumSpeed) continue;
-    // the most compressed stretch spring inside the subdomain (lowest index on ties)
-    int best = -1;
-    float bestEps = -params.compressionThreshold;
-    for (int v : dom) {
-      stretchOf(v, list);
-      for (int s : list) {
-        if (owner[springs.ids[s][0]] != static_cast<int>(k) || owner[springs.ids[s][1]] != static_cast<int>(k)) continue;
-        const float e = strain(s);
-        if (e < bestEps || (e == bestEps && best >= 0 && s < best)) {
-          best = s;
-          bestEps = e;
-        }
-      }
-    }
+    const int best = mostCompressedSpring(view, dom, static_cast<int>(k), owner, params.compressionThreshold, list);
     if (best < 0) continue;
     // A: the free end whose stretch springs are more compressed on average
-    auto meanStrain = [&](int v) {
-      stretchOf(v, list);
-      float sum = 0.0f;
-      for (int s : list) sum += strain(s);
-      return list.empty() ? 0.0f : sum / static_cast<float>(list.size());
-    };
     int a = springs.ids[best][0], b = springs.ids[best][1];
-    if (pinned(a) || (!pinned(b) && meanStrain(b) < meanStrain(a))) std::swap(a, b);
-    if (pinned(a)) continue;
-    // C, D: A's other stretch neighbours, most compressed first, with B, C, D not collinear
-    stretchOf(a, list);
-    std::vector<std::pair<float, int>> others;
-    for (int s : list)
-      if (s != best) others.push_back({strain(s), s});
-    std::sort(others.begin(), others.end());
-    const float l0ab = springs.restLength[best];
+    if (view.pinned(a) || (!view.pinned(b) && view.meanStrain(b, list) < view.meanStrain(a, list))) std::swap(a, b);
+    if (view.pinned(a)) continue;
     int sc = -1, sd = -1;
-    for (size_t u = 0; u < others.size() && sc < 0; ++u)
-      for (size_t w = u + 1; w < others.size(); ++w) {
-        const Vec3 c = pos(springs.other(others[u].second, a)), d = pos(springs.other(others[w].second, a));
-        if ((c - pos(b)).cross(d - pos(b)).norm() > 0.05f * l0ab * l0ab) {
-          sc = others[u].second;
-          sd = others[w].second;
-          break;
-        }
-      }
-    if (sc < 0) continue;
+    if (!sideSprings(view, a, b, best, list, sc, sd)) continue;
     const int c = springs.other(sc, a), d = springs.other(sd, a);
+    const float l0ab = springs.restLength[best];
     // Eq. 25: where all three springs would be at rest length
-    const SphereIntersection hits = intersectThreeSpheres(pos(b), l0ab, pos(c), springs.restLength[sc], pos(d),
-                                                          springs.restLength[sd], 1e-4f * l0ab);
+    const SphereIntersection hits = intersectThreeSpheres(view.pos(b), l0ab, view.pos(c), springs.restLength[sc],
+                                                          view.pos(d), springs.restLength[sd], 1e-4f * l0ab);
     if (hits.count == 0) continue;
     std::array<bool, 2> collides{false, false};
     for (int h = 0; h < hits.count; ++h) collides[h] = insideCollider(model, poses, hits.point[h], margin);
     const int coin = static_cast<int>(splitmix(splitmix(params.seed ^ (uint64_t(piece) << 32)) ^ (uint64_t(a) << 20) ^
                                                stepIndex) & 1u);
-    const int pick = chooseDisturbance(pos(a), hits, collides, pos(b), pos(d), params.tieTolerance * l0ab, coin);
+    const Vec3& pa = view.pos(a);
+    const int pick = chooseDisturbance(pa, hits, collides, view.pos(b), view.pos(d), params.tieTolerance * l0ab, coin);
     // an imperfection is small: a target further than one rest length from A is not used (departure 14)
-    if (pick >= 0 && (hits.point[pick] - pos(a)).norm() <= l0ab)
-      out.push_back({a, pos(a) + params.strength * (hits.point[pick] - pos(a))});
+    if (pick >= 0 && (hits.point[pick] - pa).norm() <= l0ab) out.push_back({a, pa + params.strength * (hits.point[pick] - pa)});
   }
   return out;
 }
