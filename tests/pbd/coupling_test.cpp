@@ -1,6 +1,6 @@
 // the water-cloth coupling of Eq. 21-22 (src/pbd/coupling.cpp): its constraint, no tunnelling of
-// fast drops, a moving sheet carrying water, the side a particle is held on, the rigid final pass
-// at dry triangles only, and Fig. 3(a) without a crossing
+// fast drops, a moving sheet carrying water, the rigid final pass at dry triangles only, and Fig. 3(a)
+// without a crossing (the candidate search and the sides: coupling_search_test.cpp)
 #include "support/crossings.hpp"
 #include "support/run_scene.hpp"
 
@@ -116,50 +116,6 @@ TEST(Coupling, SheetSweptPastStillWaterCarriesItAlong) {
     ++over;
   }
   EXPECT_GT(over, 50u);
-}
-
-TEST(Coupling, CouplingSideFollowsTheFaceUnderAParticleOnATightlyCurvedSheet) {
-  // a sheet rolled onto a half cylinder of radius 5 cm (spacing 2 cm) and a water particle 0.3 mm
-  // outside it, halfway between two vertex rows: the tangent plane at the nearest vertex passes
-  // outside the particle (the sagitta s^2 / 8R is 1 mm), so that vertex's normal puts the particle on
-  // the inner side while the face under it says outer. Every candidate must take the face's side: the
-  // triangles beside it, given the other side, pushed the particle through the face under it
-  Scene scene = sceneFromJson(R"({
-    "solver": {"gravity": [0, 0, 0], "domain": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
-    "cloth": [{"mesh": {"type": "rectangle", "center": [0, 0, 0], "size": [0.16, 0.16], "resolution": [9, 9],
-               "axisU": [1, 0, 0], "axisV": [0, 0, 1]}}]
-  })");
-  const float R = 0.05f, eps = 0.0003f;
-  Particles& p = scene.state.particles;
-  const auto roll = [&](float u, float z, float out) {  // arc length u from the top, out along the outward normal
-    const float a = u / R;
-    return Vec3((R + out) * std::sin(a), (R + out) * std::cos(a) - R, z);
-  };
-  for (int i = 0; i < scene.model.numCloth; ++i) p.x[i] = p.xPred[i] = roll(p.x[i].x(), p.x[i].z(), 0.0f);
-  const Vec3 q = roll(0.01f, 0.0f, eps);  // between the vertex rows at u = 0 and 0.02, on the row z = 0
-  p.add(kWaterPhase, 1000, scene.model.water.particleMass, scene.model.water.supportRadius, q, Vec3::Zero());
-  p.xPred.back() = q;
-  CouplingScratch s;
-  findCouplingCandidates(scene.model, p, s);
-  ASSERT_EQ(s.candidateStart.size(), 2u);
-  const uint32_t c0 = s.candidateStart[0], c1 = s.candidateStart[1];
-  ASSERT_GT(c1 - c0, 4u);
-  // the side of the face under q: its chord plane lies inside the arc, so q is on the outer side
-  float under = 0.0f;
-  for (uint32_t c = c0; c < c1; ++c) {
-    const auto& f = scene.model.triangles[s.candidates[c]];
-    const Vec3 &a = p.x[f[0]], &b = p.x[f[1]], &d = p.x[f[2]];
-    const Vec3 n = (b - a).cross(d - a).normalized();
-    const float dist = (q - a).dot(n);
-    const Vec3 foot = q - dist * n;
-    // barycentric inside test of the foot point
-    const Vec3 v0 = b - a, v1 = d - a, v2 = foot - a;
-    const float d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
-    const float den = d00 * d11 - d01 * d01, v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
-    if (v >= 0 && w >= 0 && v + w <= 1) under = dist > 0.0f ? 1.0f : -1.0f;
-  }
-  ASSERT_NE(under, 0.0f);
-  for (uint32_t c = c0; c < c1; ++c) EXPECT_EQ(s.candidateSide[c], under) << "candidate triangle " << s.candidates[c];
 }
 
 TEST(Coupling, RigidCouplingPassHoldsWaterAtDryTrianglesOnly) {
