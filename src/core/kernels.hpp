@@ -4,6 +4,8 @@
 #pragma once
 #include <soak/math.hpp>
 
+#include "core/simd.hpp"
+
 #include <cmath>
 
 namespace soak {
@@ -38,21 +40,37 @@ inline F spikyGradCoefOfInverse(F inv) {
   return kSpikyGradNorm * inv6;
 }
 
+// The kernels' formulas, each written once, from a factor computed above (or cached, or per lane):
+// templates on the lane type (float, or simd::FloatW where the build has it), with selects only, so
+// that `omp simd` loops and the hand-vectorised ones (pbd/fluid_pairs.hpp) run the same arithmetic.
+// W_poly6 = coef (h^2 - r^2)^3, 0 outside the support; coef = poly6Coef(h, h^2)
+template <class F>
+inline F poly6From(F coef, F h2, F r2) {
+  const F d = simd::max(h2 - r2, F(0.0f));
+  return coef * d * d * d;
+}
+// the factor f of grad W_spiky = f r (r = x_i - x_j, |r|^2 = r2): coef (h - |r|)^2 / |r|; 0 outside
+// the support, at r = 0 and where not active. coef = spikyGradCoef(h^3)
+template <class F, class M>
+inline F spikyGradFactorFrom(F coef, F h, F r2, M active) {
+  const F len = simd::sqrt(r2), d = h - len;
+  return simd::divideOrZero(active & (len < h) & (len > F(1e-9f)), coef * d * d, len);
+}
+
 // W_poly6(r, h) = 315 / (64 pi h^9) (h^2 - r^2)^3 for r < h
 inline float poly6(float r2, float h) {
   const float h2 = h * h;
-  if (r2 >= h2) return 0.0f;
-  const float d = h2 - r2;
-  return poly6Coef(h, h2) * d * d * d;
+  return poly6From(poly6Coef(h, h2), h2, r2);
 }
+
+// the factor f of grad W_spiky(r, h) = f r, from |r|^2
+inline float spikyGradFactor(float r2, float h) { return spikyGradFactorFrom(spikyGradCoef(h * h * h), h, r2, true); }
 
 // grad W_spiky(r, h) = -45 / (pi h^6) (h - r)^2 r_hat, with r = x_i - x_j
 inline Vec3 spikyGrad(const Vec3& r, float h) {
   const float len = r.norm();
   if (len >= h || len <= 1e-9f) return Vec3::Zero();
-  const float h3 = h * h * h;
-  const float d = h - len;
-  return (spikyGradCoef(h3) * d * d / len) * r;
+  return spikyGradFactor(r.squaredNorm(), h) * r;
 }
 
 // poly6 and the spiky gradient for one support radius, with its constants computed once: loops over
@@ -68,16 +86,11 @@ struct KernelCache {
     poly6Coef = soak::poly6Coef(h, h2);
     spikyCoef = spikyGradCoef(h3);
   }
-  float poly6(float r2) const {
-    if (r2 >= h2) return 0.0f;
-    const float d = h2 - r2;
-    return poly6Coef * d * d * d;
-  }
+  float poly6(float r2) const { return poly6From(poly6Coef, h2, r2); }
   Vec3 spikyGrad(const Vec3& r) const {
     const float len = r.norm();
     if (len >= h || len <= 1e-9f) return Vec3::Zero();
-    const float d = h - len;
-    return (spikyCoef * d * d / len) * r;
+    return spikyGradFactorFrom(spikyCoef, h, r.squaredNorm(), true) * r;
   }
 };
 
@@ -89,11 +102,10 @@ inline float spiky(float r, float h) {
   return 15.0f / (kPi * h3 * h3) * d * d * d;
 }
 
-// Laplacian of the viscosity kernel: 45 / (pi h^6) (h - r), positive, for diffusion (Eq. 12)
+// Laplacian of the viscosity kernel: 45 / (pi h^6) (h - r), positive, for diffusion (Eq. 12); a
+// select, for `omp simd` loops
 inline float viscosityLaplacian(float r, float h) {
-  if (r >= h) return 0.0f;
-  const float h3 = h * h * h;
-  return viscosityLaplacianCoef(h3) * (h - r);
+  return r >= h ? 0.0f : viscosityLaplacianCoef(h * h * h) * (h - r);
 }
 
 // a poly6 kernel of support h cut by a plane wall (pbd/boundary.cpp), with its factor

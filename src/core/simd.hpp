@@ -30,7 +30,12 @@ inline float sqrt(float a) { return std::sqrt(a); }
 // x limited to [lo, hi] as std::min(std::max(x, lo), hi): a NaN x stays NaN
 inline float clamp(float x, float lo, float hi) { return std::min(std::max(x, lo), hi); }
 inline float select(bool m, float a) { return m ? a : 0.0f; }  // a where m, else 0
-inline float divideOrZero(bool m, float a, float b) { return m ? a / b : 0.0f; }
+// a / b where m, else 0; b is replaced where not m, so the division can be done in every lane of an
+// `omp simd` loop without a fault
+inline float divideOrZero(bool m, float a, float b) {
+  const float safe = m ? b : 1.0f;
+  return m ? a / safe : 0.0f;
+}
 
 #if SOAK_SIMD_WIDE
 constexpr uint32_t kLanes = 16;

@@ -22,16 +22,14 @@ inline PairKernel<F> pairKernel(F h, F inv) {
 // W_poly6(r_ij, h_ij) from r^2, 0 outside the support
 template <class F>
 inline F poly6Value(const PairKernel<F>& k, F r2) {
-  const F d = simd::max(k.h2 - r2, F(0.0f));
-  return k.poly6 * d * d * d;
+  return poly6From(k.poly6, k.h2, r2);
 }
 
 // the factor f of grad W_spiky(r_ij, h_ij) = f r_ij (r_ij = x_i - x_j); 0 outside the support, at
 // r = 0 and where not active
 template <class F, class M>
 inline F spikyFactor(const PairKernel<F>& k, F r2, M active) {
-  const F len = simd::sqrt(r2), d = k.h - len;
-  return simd::divideOrZero(active & (len < k.h) & (len > F(1e-9f)), k.spiky * d * d, len);
+  return spikyGradFactorFrom(k.spiky, k.h, r2, active);
 }
 
 // artificial pressure s_corr = -k (W_ij / W(dq))^n (PBF Eq. 13), in lambda units. With dq = c h,

@@ -244,8 +244,7 @@ void outflowScales(const Model& model, const NeighborLists& nb, const FlowInputs
       const uint32_t ll = same ? l : static_cast<uint32_t>(u);  // buffers hold cloth only
       const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
       const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL);  // and l's buffer takes water
-      const float vw = vu * W[k];
-      T[k] = rateL * static_cast<double>(cosLU * vw * (below ? 1.0f : 0.0f)) * bu;  // +-0 where not below
+      T[k] = bufferFlow(rateL, cosLU, vu, W[k], bu) * (below ? 1.0 : 0.0);  // +-0 where not below
     }
     double out = 0.0;
     for (uint32_t k = 0; k < count; ++k) out += T[k];
@@ -301,9 +300,9 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
       const float osj = OS[jj];
       const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullL);     // j sheds into k
       const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL);   // k sheds into j
-      // outScale_u * rawFlow(u), rawFlow = rate (cos theta_lu V_u W) EW_u
-      const double in = static_cast<double>(osj) * (rateL * static_cast<double>(cosKJ * (VL[jj] * W[e])) * B[jj]);
-      const double out = static_cast<double>(osk) * (rateL * static_cast<double>(-cosKJ * (vk * W[e])) * bk);
+      // outScale_u bufferFlow(u -> l)
+      const double in = static_cast<double>(osj) * bufferFlow(rateL, cosKJ, VL[jj], W[e], B[jj]);
+      const double out = static_cast<double>(osk) * bufferFlow(rateL, -cosKJ, vk, W[e], bk);
       T[e] = in * (fromJ ? 1.0 : 0.0) - out * (toJ ? 1.0 : 0.0);  // in, -out or +-0
     }
     double d = 0.0;

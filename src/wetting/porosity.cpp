@@ -84,11 +84,11 @@ void computeSaturation(const Model& model, const State& state, const WettingScra
   parallelFor(nc, [&](int64_t i) { sat[i] = saturationOf(c, state.clothWater[i], s.volume[i]); });
 }
 
-// The pair loop is written for `omp simd` (plain floats, selects, gathers of j's position and radius)
-// and computes each value with the arithmetic of the scalar functions it replaces, in the same order
-// (Eigen's squaredNorm and dot of a Vec3 are x + (y + z)): poly6(), viscosityLaplacian(), spikyGrad()
-// and cosGravity() at (x_i - x_j, pairRadius(h_i, h_j)) give bit for bit the stored values. Only
-// values are stored, no sums, so the vector width changes nothing.
+// The pair loop is written for `omp simd` (plain floats, gathers of j's position and radius) and calls
+// the select-only kernels poly6(), viscosityLaplacian(), spikyGradFactor() and cosGravityOf() with
+// x_i - x_j summed as Eigen sums a Vec3 (x + (y + z)): the stored values are those of poly6(),
+// spikyGrad() and cosGravity() at (x_i - x_j, pairRadius(h_i, h_j)), bit for bit. Only values are
+// stored, no sums, so the vector width changes nothing.
 namespace {
 
 // pairGeometry, then after(i) for each cloth particle i in the same parallel loop (one fork and join)
@@ -126,25 +126,12 @@ void pairGeometryThen(const Model& model, const Particles& p, const NeighborList
     for (uint32_t e = begin; e < end; ++e) {
       const uint32_t j = index[e];
       const float dx = xi - X[3 * j], dy = yi - X[3 * j + 1], dz = zi - X[3 * j + 2];
-      const float r2 = dx * dx + (dy * dy + dz * dz);
-      const float h = 0.5f * (hi + H[j]);  // pairRadius
-      // poly6(r2, h)
-      const float h2 = h * h;
-      const float dq = h2 - r2;
-      P6[e] = r2 >= h2 ? 0.0f : poly6Coef(h, h2) * dq * dq * dq;
-      // cosGravity(x_i, x_j, g); rCos and rGrad are r where the value is kept and only guard the
-      // divisions of the lanes the selects drop (no std::max: it returns a reference, a memory load)
-      const float r = std::sqrt(r2);
-      const float dot = dx * gx + (dy * gy + dz * gz);
-      const float rCos = r > 1e-12f ? r : 1.0f;
-      C[e] = r > 1e-12f ? dot / rCos : 0.0f;
-      // viscosityLaplacian(r, h) and the factor of spikyGrad(x_i - x_j, h)
-      const float h3 = h * h * h;
-      const float dh = h - r;
-      L[e] = r >= h ? 0.0f : viscosityLaplacianCoef(h3) * dh;
-      const bool inGrad = (r < h) & (r > 1e-9f);
-      const float rGrad = inGrad ? r : 1.0f;
-      F[e] = inGrad ? spikyGradCoef(h3) * dh * dh / rGrad : 0.0f;
+      const float r2 = dx * dx + (dy * dy + dz * dz), r = std::sqrt(r2);
+      const float h = pairRadius(hi, H[j]);
+      P6[e] = poly6(r2, h);
+      C[e] = cosGravityOf(dx * gx + (dy * gy + dz * gz), r);
+      L[e] = viscosityLaplacian(r, h);
+      F[e] = spikyGradFactor(r2, h);
     }
     after(i);
   });

@@ -14,6 +14,7 @@
 #include <soak/state.hpp>
 
 #include "core/parallel.hpp"
+#include "core/simd.hpp"
 #include "grid/grid.hpp"
 #include "world/colliders.hpp"
 
@@ -88,11 +89,13 @@ inline Vec3 gravityDirection(const Model& model) {
   return g > 1e-12f ? Vec3(model.solver.gravity / g) : Vec3::Zero();
 }
 
+// cos theta_ij from (x_i - x_j) . g and |x_i - x_j| (0 for coincident particles); a select, for
+// `omp simd` loops
+inline float cosGravityOf(float dot, float len) { return simd::divideOrZero(len > 1e-12f, dot, len); }
 // cos theta_ij of Shao 2017: the angle between x_i - x_j and gravity; positive when i lies below j
 inline float cosGravity(const Vec3& xi, const Vec3& xj, const Vec3& gDir) {
   const Vec3 d = xi - xj;
-  const float len = d.norm();
-  return len > 1e-12f ? d.dot(gDir) / len : 0.0f;
+  return cosGravityOf(d.dot(gDir), d.norm());
 }
 
 // porosity.cpp ------------------------------------------------------------------------------------
@@ -158,6 +161,13 @@ void finishWetting(const Model& model, State& state, WettingScratch& s);
 void diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
 
 // emission.cpp ------------------------------------------------------------------------------------
+
+// Eq. 18's flow from the buffer of an upper particle u to a lower neighbour l over a pass, before u's
+// outflow scale: rate cos theta_lu V_u W_lu EW_u (kg), cos theta_lu > 0 (l below u). The one formula
+// of the outflow and the net-flow loops, so that the water leaving u is the water arriving at l
+inline double bufferFlow(double rate, float cosLU, float volumeU, float w, double bufferU) {
+  return rate * static_cast<double>(cosLU * (volumeU * w)) * bufferU;
+}
 
 // section 4.4: water above S^EW moves into the buffer; buffers pass down to the neighbours below when
 // Eq. 18 holds; a buffer that reaches m^threshold forms a drip below the cloth (placed where its

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 
 using namespace soak;
 
@@ -21,6 +23,15 @@ double integrate3(float h, int n, F&& f) {
       }
   return sum * dx * dx * dx;
 }
+#if SOAK_SIMD_WIDE
+// f(v[l]) in lane l
+template <class F>
+simd::FloatW FloatWOf(const float* v, simd::MaskW m, F&& f) {
+  float out[16];
+  for (int l = 0; l < 16; ++l) out[l] = f(v[l]);
+  return simd::load(out, m);
+}
+#endif
 }  // namespace
 
 TEST(Kernels, Poly6AndSpikyIntegrateToOne) {
@@ -53,6 +64,40 @@ TEST(Kernels, SpikyGradientMatchesFiniteDifferences) {
       EXPECT_NEAR(g[a], fd, 1e-3 * std::abs(fd) + 1e-2) << a;
     }
   }
+}
+
+// one formula, several callers: the cached kernels, the factor form and (where the build has it) the
+// vector lanes give the scalar kernels' values bit for bit
+TEST(Kernels, EveryFormOfAKernelIsTheSameNumber) {
+  const auto same = [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-0.05f, 0.05f), hr(0.02f, 0.06f);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 r(u(rng), u(rng), u(rng));
+    const float h = hr(rng), r2 = r.squaredNorm();
+    KernelCache cache;
+    cache.set(h);
+    EXPECT_TRUE(same(cache.poly6(r2), poly6(r2, h))) << k;
+    const Vec3 g = spikyGrad(r, h), gc = cache.spikyGrad(r), gf = spikyGradFactor(r2, h) * r;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_TRUE(same(gc[a], g[a])) << k;
+      if (r.norm() < h) EXPECT_TRUE(same(gf[a], g[a])) << k;
+    }
+    EXPECT_TRUE(same(viscosityLaplacian(r.norm(), h), r.norm() >= h ? 0.0f : viscosityLaplacianCoef(h * h * h) * (h - r.norm())));
+  }
+  EXPECT_EQ(spikyGradFactor(0.0f, 0.04f), 0.0f);  // no direction at r = 0
+#if SOAK_SIMD_WIDE
+  float hs[16], r2s[16];
+  for (int l = 0; l < 16; ++l) hs[l] = hr(rng), r2s[l] = std::pow(u(rng) + 0.05f, 2.0f);
+  const simd::MaskW all = simd::firstLanes(16);
+  const simd::FloatW H = simd::load(hs, all), R2 = simd::load(r2s, all);
+  const simd::FloatW p6 = poly6From(FloatWOf(hs, all, [](float h) { return poly6Coef(h, h * h); }), H * H, R2);
+  const simd::FloatW sf = spikyGradFactorFrom(FloatWOf(hs, all, [](float h) { return spikyGradCoef(h * h * h); }), H, R2, all);
+  for (int l = 0; l < 16; ++l) {
+    EXPECT_TRUE(same(simd::lane(p6, l), poly6(r2s[l], hs[l]))) << l;
+    EXPECT_TRUE(same(simd::lane(sf, l), spikyGradFactor(r2s[l], hs[l]))) << l;
+  }
+#endif
 }
 
 TEST(Kernels, WallFractionIsTheHalfSpaceIntegral) {

@@ -287,3 +287,17 @@ TEST(WettingEmission, SaturatedHangingClothDrainsAndDrips) {
         std::min(i < size_t(s.model.numCloth) ? lowestCloth : lowestWater, p.x[i].y());
   EXPECT_TRUE(lowestWater < lowestCloth - 0.1f || s.state.ledger.particlesRemovedAtBounds > 0);
 }
+
+// Eq. 18's flow from an upper particle's buffer: rate cos V_u W EW_u, linear in each factor, 0 with
+// no slope; the outflow and net-flow loops both take it from bufferFlow
+TEST(WettingEmission, BufferFlowIsEq18) {
+  const double rate = 0.25, bu = 3e-5;
+  const float cosLU = 0.6f, vu = 2e-7f, w = 1.5e5f;
+  const double expected = rate * double(cosLU) * double(vu) * double(w) * bu;
+  EXPECT_NEAR(bufferFlow(rate, cosLU, vu, w, bu), expected, 1e-6 * expected);
+  EXPECT_NEAR(bufferFlow(2.0 * rate, cosLU, vu, w, bu), 2.0 * expected, 2e-6 * expected);
+  EXPECT_NEAR(bufferFlow(rate, 0.5f * cosLU, vu, w, bu), 0.5 * expected, 1e-6 * expected);
+  EXPECT_EQ(bufferFlow(rate, 0.0f, vu, w, bu), 0.0);
+  // a buffer's water over the pass: never more than it holds for rate <= 1, cos <= 1 and V W <= 1
+  EXPECT_LE(bufferFlow(1.0, 1.0f, 1.0f, 1.0f, bu), bu);
+}
