@@ -92,7 +92,7 @@ void researchAndSweep(const Model& model, const Particles& p, const CouplingScra
   const size_t w = static_cast<size_t>(q - nc);
   const uint32_t c0 = s.candidateStart[w], c1 = s.candidateStart[w + 1];
   const Vec3 a = p.x[q];
-  const float reachQ = 0.5f * (p.radius[q] + s.clothRadius);  // as in findCouplingCandidates
+  const float reachQ = pairRadius(p.radius[q], s.clothRadius);  // as in findCouplingCandidates
   // the candidates and the triangles found so far carry the stamp (a folded sheet gives hundreds of
   // candidates: a linear search of them per triangle was most of Fig. 6(b)'s coupling)
   for (uint32_t c = c0; c < c1; ++c) mark[s.candidates[c]] = stamp;

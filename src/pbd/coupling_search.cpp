@@ -183,7 +183,7 @@ void collectCandidates(const Model& model, const Particles& p, CouplingScratch& 
     for (int64_t w = begin; w < end; ++w) {
       const int64_t q = nc + w;
       const Vec3 a = p.x[q], ab = p.xPred[q] - a;
-      const float reachQ = 0.5f * (p.radius[q] + hCloth), reach = std::min(reachMax, reachQ);
+      const float reachQ = pairRadius(p.radius[q], hCloth), reach = std::min(reachMax, reachQ);
       float nearest2 = std::numeric_limits<float>::max();
       int32_t nearest = -1;
       // cloth particle j lies within reach of the path: its triangles are candidates

@@ -4,6 +4,7 @@
 #pragma once
 #include "pbd/coupling.hpp"
 
+#include "core/kernels.hpp"
 #include "core/simd.hpp"
 
 #include <algorithm>
