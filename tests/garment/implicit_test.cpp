@@ -1,6 +1,6 @@
-// the implicit garment solver (Chen 2012 Eq. 1-5 after Baraff & Witkin 1998): filtered PCG,
-// stability at a large step where explicit Euler diverges, pinned vertices, reported CG failure,
-// collider contact with wet friction, determinism
+// the implicit garment solver (Chen 2012 Eq. 1-5 after Baraff & Witkin 1998): stability at a large step
+// where explicit Euler diverges, pinned vertices, reported CG failure, collider contact with wet friction,
+// determinism (the filtered PCG itself: block_cg_test.cpp)
 #include "garment/implicit.hpp"
 
 #include <soak/error.hpp>
@@ -45,59 +45,6 @@ ImplicitStats stepRig(Rig& r, double t, float h, const std::vector<PositionConst
   const ImplicitStats s = implicitStep(r.model, r.g, r.params, t, h, r.poses, wetStart, constraints, r.p, r.scratch);
   r.p.x = r.p.xPred;  // the caller's commit
   return s;
-}
-
-TEST(GarmentCg, FilteredPcgSolvesFreeRowsAndKeepsConstrainedRows) {
-  // a random SPD 3x3-block tridiagonal matrix of 6 rows
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int n = 6;
-  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  for (int i = 0; i + 1 < n; ++i) {
-    Eigen::Matrix3d b;
-    for (int k = 0; k < 9; ++k) b(k / 3, k % 3) = u(rng);
-    dense.block<3, 3>(3 * i, 3 * i + 3) = b;
-    dense.block<3, 3>(3 * i + 3, 3 * i) = b.transpose();
-  }
-  dense += 8.0 * Eigen::MatrixXd::Identity(3 * n, 3 * n);
-  BlockMatrix A;
-  A.rows = n;
-  A.rowStart.push_back(0);
-  for (int i = 0; i < n; ++i) {
-    A.col.push_back(i);
-    A.block.push_back(dense.block<3, 3>(3 * i, 3 * i));
-    for (int j : {i - 1, i + 1})
-      if (j >= 0 && j < n) {
-        A.col.push_back(j);
-        A.block.push_back(dense.block<3, 3>(3 * i, 3 * j));
-      }
-    A.rowStart.push_back(int(A.col.size()));
-  }
-  std::vector<Vec3d> b(n), x(n, Vec3d::Zero());
-  for (auto& v : b) v = Vec3d(u(rng), u(rng), u(rng));
-  std::vector<uint8_t> constrained{0, 1, 0, 0, 1, 0};
-  x[1] = Vec3d(0.3, -0.2, 0.1);
-  x[4] = Vec3d(-1.0, 0.5, 2.0);
-  const std::vector<Vec3d> z = x;
-  CgScratch scratch;
-  const CgResult res = filteredPcg(A, b, constrained, x, CgOptions{1e-10, 200}, scratch);
-  EXPECT_TRUE(res.converged);
-  EXPECT_LE(res.residual, 1e-10);
-  EXPECT_EQ(x[1], z[1]);
-  EXPECT_EQ(x[4], z[4]);
-  // reference: the free rows of A x = b with the constrained x fixed, solved densely
-  const std::vector<int> freeRows{0, 2, 3, 5};
-  Eigen::MatrixXd Aff(12, 12);
-  Eigen::VectorXd rhs(12);
-  Eigen::VectorXd xc = Eigen::VectorXd::Zero(3 * n);
-  for (int i : {1, 4}) xc.segment<3>(3 * i) = z[i];
-  const Eigen::VectorXd Axc = dense * xc;
-  for (int a = 0; a < 4; ++a) {
-    rhs.segment<3>(3 * a) = b[freeRows[a]] - Axc.segment<3>(3 * freeRows[a]);
-    for (int c = 0; c < 4; ++c) Aff.block<3, 3>(3 * a, 3 * c) = dense.block<3, 3>(3 * freeRows[a], 3 * freeRows[c]);
-  }
-  const Eigen::VectorXd ref = Aff.ldlt().solve(rhs);
-  for (int a = 0; a < 4; ++a) EXPECT_LT((x[freeRows[a]] - ref.segment<3>(3 * a)).norm(), 1e-8);
 }
 
 TEST(GarmentImplicit, NonConvergingCgIsReported) {

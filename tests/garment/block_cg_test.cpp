@@ -1,0 +1,287 @@
+// the block matrices and the filtered PCG of Baraff & Witkin 1998 (section 5.3) that the implicit garment
+// solve uses: products against dense algebra, constrained rows held, the preconditioner, the reported
+// breakdown and iteration cap, and the same answer for any thread count
+#include "garment/block_cg.hpp"
+
+#include <soak/threads.hpp>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+namespace soak {
+namespace {
+
+// the 3x3 blocks of `dense` (3n x 3n) where it is not zero, diagonal first in each row
+BlockMatrix blocksOf(const Eigen::MatrixXd& dense) {
+  const int n = int(dense.rows() / 3);
+  BlockMatrix A;
+  A.rows = n;
+  A.rowStart.push_back(0);
+  for (int i = 0; i < n; ++i) {
+    A.col.push_back(i);
+    A.block.push_back(dense.block<3, 3>(3 * i, 3 * i));
+    for (int j = 0; j < n; ++j)
+      if (j != i && dense.block<3, 3>(3 * i, 3 * j).cwiseAbs().maxCoeff() > 0.0) {
+        A.col.push_back(j);
+        A.block.push_back(dense.block<3, 3>(3 * i, 3 * j));
+      }
+    A.rowStart.push_back(int(A.col.size()));
+  }
+  return A;
+}
+
+Eigen::Matrix3d randomBlock(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix3d b;
+  for (int k = 0; k < 9; ++k) b(k / 3, k % 3) = u(rng);
+  return b;
+}
+
+TEST(GarmentCg, FilteredPcgSolvesFreeRowsAndKeepsConstrainedRows) {
+  // a random SPD 3x3-block tridiagonal matrix of 6 rows
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 6;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int i = 0; i + 1 < n; ++i) {
+    Eigen::Matrix3d b;
+    for (int k = 0; k < 9; ++k) b(k / 3, k % 3) = u(rng);
+    dense.block<3, 3>(3 * i, 3 * i + 3) = b;
+    dense.block<3, 3>(3 * i + 3, 3 * i) = b.transpose();
+  }
+  dense += 8.0 * Eigen::MatrixXd::Identity(3 * n, 3 * n);
+  BlockMatrix A;
+  A.rows = n;
+  A.rowStart.push_back(0);
+  for (int i = 0; i < n; ++i) {
+    A.col.push_back(i);
+    A.block.push_back(dense.block<3, 3>(3 * i, 3 * i));
+    for (int j : {i - 1, i + 1})
+      if (j >= 0 && j < n) {
+        A.col.push_back(j);
+        A.block.push_back(dense.block<3, 3>(3 * i, 3 * j));
+      }
+    A.rowStart.push_back(int(A.col.size()));
+  }
+  std::vector<Vec3d> b(n), x(n, Vec3d::Zero());
+  for (auto& v : b) v = Vec3d(u(rng), u(rng), u(rng));
+  std::vector<uint8_t> constrained{0, 1, 0, 0, 1, 0};
+  x[1] = Vec3d(0.3, -0.2, 0.1);
+  x[4] = Vec3d(-1.0, 0.5, 2.0);
+  const std::vector<Vec3d> z = x;
+  CgScratch scratch;
+  const CgResult res = filteredPcg(A, b, constrained, x, CgOptions{1e-10, 200}, scratch);
+  EXPECT_TRUE(res.converged);
+  EXPECT_LE(res.residual, 1e-10);
+  EXPECT_EQ(x[1], z[1]);
+  EXPECT_EQ(x[4], z[4]);
+  // reference: the free rows of A x = b with the constrained x fixed, solved densely
+  const std::vector<int> freeRows{0, 2, 3, 5};
+  Eigen::MatrixXd Aff(12, 12);
+  Eigen::VectorXd rhs(12);
+  Eigen::VectorXd xc = Eigen::VectorXd::Zero(3 * n);
+  for (int i : {1, 4}) xc.segment<3>(3 * i) = z[i];
+  const Eigen::VectorXd Axc = dense * xc;
+  for (int a = 0; a < 4; ++a) {
+    rhs.segment<3>(3 * a) = b[freeRows[a]] - Axc.segment<3>(3 * freeRows[a]);
+    for (int c = 0; c < 4; ++c) Aff.block<3, 3>(3 * a, 3 * c) = dense.block<3, 3>(3 * freeRows[a], 3 * freeRows[c]);
+  }
+  const Eigen::VectorXd ref = Aff.ldlt().solve(rhs);
+  for (int a = 0; a < 4; ++a) EXPECT_LT((x[freeRows[a]] - ref.segment<3>(3 * a)).norm(), 1e-8);
+}
+
+// y = A x row by row equals the dense product, for a non-symmetric pattern with a gap in it
+TEST(GarmentCg, MultiplyMatchesTheDenseProduct) {
+  std::mt19937 rng(11);
+  const int n = 5;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  const int pattern[][2] = {{0, 0}, {0, 3}, {1, 1}, {1, 0}, {2, 2}, {2, 4}, {3, 3}, {4, 4}, {4, 1}};
+  for (const auto& ij : pattern) dense.block<3, 3>(3 * ij[0], 3 * ij[1]) = randomBlock(rng);
+  const BlockMatrix A = blocksOf(dense);
+  ASSERT_EQ(A.block.size(), 9u);
+  std::vector<Vec3d> x(n), y;
+  Eigen::VectorXd xd(3 * n);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int i = 0; i < n; ++i) {
+    x[i] = Vec3d(u(rng), u(rng), u(rng));
+    xd.segment<3>(3 * i) = x[i];
+  }
+  A.multiply(x, y);
+  const Eigen::VectorXd yd = dense * xd;
+  ASSERT_EQ(y.size(), size_t(n));
+  for (int i = 0; i < n; ++i) EXPECT_LT((y[i] - yd.segment<3>(3 * i)).norm(), 1e-12) << i;
+}
+
+// blockDot: the per-row dot products, summed in row order (bit for bit the serial loop), with the
+// per-row terms left in `partial`
+TEST(GarmentCg, BlockDotIsTheRowOrderedSum) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3d> a(40), b(40);
+  for (size_t i = 0; i < a.size(); ++i) a[i] = Vec3d(u(rng), 1e6 * u(rng), u(rng)), b[i] = Vec3d(u(rng), u(rng), 1e-6 * u(rng));
+  std::vector<double> partial;
+  const double dot = blockDot(a, b, partial);
+  double serial = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) serial += a[i].dot(b[i]);
+  EXPECT_EQ(dot, serial);
+  ASSERT_EQ(partial.size(), a.size());
+  EXPECT_EQ(partial[17], a[17].dot(b[17]));
+  // rounding shows the order: 5 x 0.75 then 1e16 gives 1e16 + 4 (the spacing of doubles there is 2), and
+  // -1e16 leaves 4; summed from the end it would be 0 + 3.75
+  std::vector<Vec3d> c(5, Vec3d(0.75, 0, 0)), e(7, Vec3d(1, 0, 0));
+  c.push_back(Vec3d(1e16, 0, 0));
+  c.push_back(Vec3d(-1e16, 0, 0));
+  EXPECT_EQ(blockDot(c, e, partial), 4.0);
+}
+
+// with block-Jacobi preconditioning a block-diagonal system is solved in one iteration: P^-1 A = I. A
+// preconditioner other than the inverse diagonal blocks needs several
+TEST(GarmentCg, BlockDiagonalSystemIsSolvedInOneIteration) {
+  std::mt19937 rng(7);
+  const int n = 8;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Matrix3d r = randomBlock(rng);
+    // SPD blocks with eigenvalues spread over two orders of magnitude
+    dense.block<3, 3>(3 * i, 3 * i) = r * r.transpose() + (0.1 + 10.0 * i) * Eigen::Matrix3d::Identity();
+  }
+  const BlockMatrix A = blocksOf(dense);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3d> b(n), x(n, Vec3d::Zero());
+  for (auto& v : b) v = Vec3d(u(rng), u(rng), u(rng));
+  CgScratch scratch;
+  const CgResult res = filteredPcg(A, b, std::vector<uint8_t>(n, 0), x, CgOptions{1e-12, 50}, scratch);
+  EXPECT_TRUE(res.converged);
+  EXPECT_EQ(res.iterations, 1);
+  for (int i = 0; i < n; ++i)
+    EXPECT_LT((x[i] - dense.block<3, 3>(3 * i, 3 * i).ldlt().solve(b[i])).norm(), 1e-12 * (1.0 + b[i].norm())) << i;
+}
+
+// a direction with c^T A c <= 0 stops the solve as a breakdown, not as convergence. [[I, 2I], [2I, I]] has
+// positive diagonal blocks (a positive preconditioner) and eigenvalues 3 and -1; b = (u, -u) lies in the
+// negative eigenspace, so the first direction (c = b) already has c^T A c = -|b|^2 < 0
+TEST(GarmentCg, IndefiniteMatrixIsReportedAsABreakdown) {
+  Eigen::MatrixXd dense(6, 6);
+  dense << Eigen::Matrix3d::Identity(), 2.0 * Eigen::Matrix3d::Identity(), 2.0 * Eigen::Matrix3d::Identity(),
+      Eigen::Matrix3d::Identity();
+  const BlockMatrix A = blocksOf(dense);
+  std::vector<Vec3d> b{Vec3d(1, 1, 1), Vec3d(-1, -1, -1)}, x(2, Vec3d::Zero());
+  CgScratch scratch;
+  const CgResult res = filteredPcg(A, b, std::vector<uint8_t>(2, 0), x, CgOptions{1e-10, 100}, scratch);
+  EXPECT_TRUE(res.breakdown);
+  EXPECT_FALSE(res.converged);
+  EXPECT_EQ(res.iterations, 0);
+  for (const Vec3d& v : x) EXPECT_TRUE(v.allFinite());
+}
+
+// BUG (src/garment/block_cg.cpp, filteredPcg): when b^T P^-1 b is negative (a diagonal block that is not
+// positive definite, e.g. A = -I) the guard meant for a zero right-hand side, `if (!(delta0 > 0.0))
+// { converged = true; return; }`, reports a converged solve with 0 iterations while x is untouched and
+// A x != b. A matrix that is not positive definite should come back as a breakdown (or not converged),
+// as the header promises ("breakdown: the matrix is not positive definite"). Enable once fixed.
+TEST(GarmentCg, DISABLED_NegativeDefiniteDiagonalIsNotReportedAsConverged) {
+  const Eigen::MatrixXd dense = -Eigen::MatrixXd::Identity(6, 6);
+  const BlockMatrix A = blocksOf(dense);
+  std::vector<Vec3d> b(2, Vec3d(1, 2, 3)), x(2, Vec3d::Zero());
+  CgScratch scratch;
+  const CgResult res = filteredPcg(A, b, std::vector<uint8_t>(2, 0), x, CgOptions{1e-10, 100}, scratch);
+  std::vector<Vec3d> ax;
+  A.multiply(x, ax);
+  const double error = (ax[0] - b[0]).norm() + (ax[1] - b[1]).norm();
+  // either it solved the system, or it did not say it did
+  EXPECT_TRUE(!res.converged || error < 1e-8) << "converged with |Ax - b| = " << error;
+}
+
+// stopped by maxIterations: not converged, the iterations and the residual at exit reported; a zero
+// right-hand side, or every row constrained, converges at once and leaves x as it was
+TEST(GarmentCg, IterationCapAndTrivialSystemsAreReported) {
+  std::mt19937 rng(9);
+  const int n = 12;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  for (int i = 0; i + 1 < n; ++i) {
+    const Eigen::Matrix3d b = randomBlock(rng);
+    dense.block<3, 3>(3 * i, 3 * i + 3) = b;
+    dense.block<3, 3>(3 * i + 3, 3 * i) = b.transpose();
+  }
+  dense += 4.0 * Eigen::MatrixXd::Identity(3 * n, 3 * n);
+  const BlockMatrix A = blocksOf(dense);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3d> b(n), x(n, Vec3d::Zero());
+  for (auto& v : b) v = Vec3d(u(rng), u(rng), u(rng));
+  CgScratch scratch;
+  CgResult res = filteredPcg(A, b, std::vector<uint8_t>(n, 0), x, CgOptions{1e-12, 2}, scratch);
+  EXPECT_FALSE(res.converged);
+  EXPECT_FALSE(res.breakdown);
+  EXPECT_EQ(res.iterations, 2);
+  EXPECT_GT(res.residual, 1e-6);
+  EXPECT_LT(res.residual, 1.0);  // but two steps did reduce it
+  // the same system to the end: the residual reported is below the tolerance
+  std::fill(x.begin(), x.end(), Vec3d::Zero());
+  res = filteredPcg(A, b, std::vector<uint8_t>(n, 0), x, CgOptions{1e-9, 500}, scratch);
+  EXPECT_TRUE(res.converged);
+  EXPECT_LE(res.residual, 1e-9);
+  EXPECT_GT(res.iterations, 2);
+
+  const std::vector<Vec3d> zero(n, Vec3d::Zero());
+  std::vector<Vec3d> still(n, Vec3d::Zero());
+  res = filteredPcg(A, zero, std::vector<uint8_t>(n, 0), still, CgOptions{}, scratch);
+  EXPECT_TRUE(res.converged);
+  EXPECT_EQ(res.iterations, 0);
+  EXPECT_EQ(still, zero);
+  std::vector<Vec3d> held(n, Vec3d(0.5, -1.0, 2.0));
+  const std::vector<Vec3d> before = held;
+  res = filteredPcg(A, b, std::vector<uint8_t>(n, 1), held, CgOptions{}, scratch);
+  EXPECT_TRUE(res.converged);
+  EXPECT_EQ(res.iterations, 0);
+  EXPECT_EQ(held, before);
+}
+
+// above 16384 rows the loops run in parallel: the solution is bit for bit the same on 1 and 2 threads,
+// and it solves the system (a 20000-row block tridiagonal matrix, a few ms a solve)
+TEST(GarmentCg, SameSolutionOnOneAndTwoThreadsForALargeSystem) {
+  const int n = 20000;
+  BlockMatrix A;
+  A.rows = n;
+  A.rowStart.push_back(0);
+  const Eigen::Matrix3d off = (Eigen::Matrix3d() << -1.0, 0.2, 0.0, 0.1, -1.0, 0.3, 0.0, -0.2, -1.0).finished();
+  for (int i = 0; i < n; ++i) {
+    A.col.push_back(i);
+    A.block.push_back(Eigen::Matrix3d::Identity() * (4.5 + 0.5 * std::sin(0.01 * i)));
+    if (i > 0) A.col.push_back(i - 1), A.block.push_back(off.transpose());
+    if (i + 1 < n) A.col.push_back(i + 1), A.block.push_back(off);
+    A.rowStart.push_back(int(A.col.size()));
+  }
+  std::vector<Vec3d> b(n);
+  for (int i = 0; i < n; ++i) b[i] = Vec3d(std::sin(0.3 * i), std::cos(0.7 * i), 1.0);
+  std::vector<uint8_t> constrained(n, 0);
+  for (int i = 0; i < n; i += 97) constrained[i] = 1;
+  const auto solve = [&](int threads) {
+    const int old = threadCount();
+    setThreadCount(threads);
+    std::vector<Vec3d> x(n, Vec3d::Zero());
+    CgScratch scratch;
+    const CgResult res = filteredPcg(A, b, constrained, x, CgOptions{1e-10, 200}, scratch);
+    setThreadCount(old);
+    EXPECT_TRUE(res.converged) << threads;
+    return x;
+  };
+  const std::vector<Vec3d> one = solve(1), two = solve(2);
+  ASSERT_EQ(one.size(), two.size());
+  EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(Vec3d)), 0);
+  // the free rows satisfy A x = b
+  std::vector<Vec3d> ax;
+  A.multiply(one, ax);
+  double worst = 0.0;
+  for (int i = 0; i < n; ++i)
+    if (!constrained[i]) worst = std::max(worst, (ax[i] - b[i]).norm());
+  EXPECT_LT(worst, 1e-7);
+  EXPECT_EQ(one[97], Vec3d::Zero());  // constrained rows keep their value
+}
+
+}  // namespace
+}  // namespace soak
