@@ -1,0 +1,368 @@
+// the Chen 2012 stages of the step (garment/stage.cpp): the wet signal of a vertex touched by a drop (and
+// the drop taken in), the wetness written to the PLY, the coupling's push turned into velocity, the
+// garment panels as wrinkle subdomains, the saturation mass of a PBD piece; then the stages inside whole
+// runs: rain wets a garment by Q(t), every drop is accounted, heavier cloth hangs lower, determinism
+#include "garment/stage.hpp"
+
+#include <soak/error.hpp>
+#include <soak/output.hpp>
+#include <soak/scene.hpp>
+#include <soak/step.hpp>
+#include <soak/threads.hpp>
+
+#include <gtest/gtest.h>
+
+#include "garment/saturation_mass.hpp"
+#include "grid/grid.hpp"
+#include "support/garment_scene.hpp"
+#include "world/colliders.hpp"
+#include "world/garment_mesh.hpp"
+
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace soak {
+namespace {
+
+using namespace soak::testing;
+
+// the unit normal of the flat rest sheet of kSheet (11 x 11 vertices)
+Vec3 sheetNormal(const Model& m) {
+  return (m.clothRestPosition[1] - m.clothRestPosition[0]).cross(m.clothRestPosition[11] - m.clothRestPosition[0]).normalized();
+}
+
+// neighbour lists on the particles' positions, as the step builds them
+void buildLists(const Particles& p, NeighborGrid& grid, NeighborLists& nb) {
+  buildGrid(p.x, 0.04f, grid);
+  buildNeighborLists(p.x, p.radius, grid, nb);
+}
+
+// a drop within touchDistance (thickness + water spacing = 0.028 m) of a vertex wets that vertex, and every
+// vertex within its reach, and vanishes into the piece (counted in the ledger); one 5% beyond it does
+// nothing. Vertices are 0.04 m apart, so each drop's reach is known exactly
+TEST(GarmentStage, ADropWetsTheVerticesWithinReachAndIsTakenIn) {
+  Scene s = fromString(kSheet);
+  const Model& m = s.model;
+  ASSERT_EQ(m.numCloth, 121);
+  const float reach = touchDistance(m, m.pieces[0]);
+  EXPECT_FLOAT_EQ(reach, 0.008f + m.water.spacing);
+  const Vec3 n = sheetNormal(m);
+  const std::vector<Vec3>& x0 = m.clothRestPosition;
+  Particles& p = s.state.particles;
+  const float mass = m.water.particleMass;
+  p.add(kWaterPhase, 1000, mass, 0.04f, x0[60] + 0.95f * reach * n, Vec3::Zero());                 // wets 60
+  p.add(kWaterPhase, 1001, 0.5f * mass, 0.04f, x0[30] + 1.05f * reach * n, Vec3::Zero());         // too far
+  p.add(kWaterPhase, 1002, 0.25f * mass, 0.04f, 0.5f * (x0[24] + x0[25]) + 0.01f * n, Vec3::Zero());  // 24, 25
+  NeighborGrid grid;
+  NeighborLists nb;
+  buildLists(p, grid, nb);
+  GarmentScratch scratch;
+  std::vector<uint8_t> keep;
+  const size_t taken = wetClothByContact(m, s.state, nb, scratch, keep, 0.5);
+  EXPECT_EQ(taken, 2u);
+  for (int i = 0; i < m.numCloth; ++i) {
+    const bool wet = i == 60 || i == 24 || i == 25;
+    if (wet)
+      EXPECT_EQ(s.state.clothWetStart[size_t(i)], 0.5f) << i;
+    else
+      EXPECT_FALSE(std::isfinite(s.state.clothWetStart[size_t(i)])) << i;
+  }
+  ASSERT_EQ(p.size(), size_t(m.numCloth) + 1);
+  EXPECT_EQ(p.id.back(), 1001u);
+  EXPECT_DOUBLE_EQ(s.state.ledger.takenByCloth, double(mass) + double(0.25f * mass));
+  EXPECT_EQ(s.state.ledger.particlesTakenByCloth, 2u);
+
+  // a second pass at a later time keeps the first wet times
+  p.x.back() = x0[30] + 0.5f * reach * n;
+  buildLists(p, grid, nb);
+  EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 0.75), 1u);
+  EXPECT_EQ(s.state.clothWetStart[30], 0.75f);
+  EXPECT_EQ(s.state.clothWetStart[60], 0.5f);
+  EXPECT_EQ(p.size(), size_t(m.numCloth));
+}
+
+// with dropsVanish off a drop still wets but stays; with Shao's wetting on, a vertex is wet once it holds
+// water, whatever touches it, and no drop is taken
+TEST(GarmentStage, DropsThatStayAndShaoWettingDecideTheWetSignalOtherwise) {
+  {
+    Scene s = fromString(kSheet, {"cloth.0.saturation.dropsVanish=false"});
+    const Model& m = s.model;
+    s.state.particles.add(kWaterPhase, 1000, m.water.particleMass, 0.04f,
+                          m.clothRestPosition[60] + 0.01f * sheetNormal(m), Vec3::Zero());
+    NeighborGrid grid;
+    NeighborLists nb;
+    buildLists(s.state.particles, grid, nb);
+    GarmentScratch scratch;
+    std::vector<uint8_t> keep;
+    EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 1.0), 0u);
+    EXPECT_EQ(s.state.clothWetStart[60], 1.0f);
+    EXPECT_EQ(s.state.particles.size(), size_t(m.numCloth) + 1);
+    EXPECT_EQ(s.state.ledger.takenByCloth, 0.0);
+  }
+  {
+    Scene s = fromString(kSheet, {"wetting.enabled=true", "wetting.emission.massThreshold=1e-5"});
+    const Model& m = s.model;
+    s.state.particles.add(kWaterPhase, 1000, m.water.particleMass, 0.04f,
+                          m.clothRestPosition[60] + 0.01f * sheetNormal(m), Vec3::Zero());
+    s.state.clothWater[7] = 1e-7;
+    NeighborGrid grid;
+    NeighborLists nb;
+    buildLists(s.state.particles, grid, nb);
+    GarmentScratch scratch;
+    std::vector<uint8_t> keep;
+    EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 2.0), 0u);
+    for (int i = 0; i < m.numCloth; ++i)
+      EXPECT_EQ(std::isfinite(s.state.clothWetStart[size_t(i)]), i == 7) << i;
+    EXPECT_EQ(s.state.clothWetStart[7], 2.0f);
+    EXPECT_EQ(s.state.particles.size(), size_t(m.numCloth) + 1);
+  }
+}
+
+// the "wetness" of the cloth PLY is Q(t - t_wet) / delta = 1 - exp(-(t - t_wet) / a3) (coarse wool,
+// a3 = 4.8936 s); 0 for a dry vertex and for a piece not wetted by contact
+TEST(GarmentStage, WetnessIsQOverDelta) {
+  Scene s = fromString(kSheet);
+  s.state.time = 10.0;
+  s.state.clothWetStart[3] = 10.0f;
+  s.state.clothWetStart[4] = 8.0f;
+  s.state.clothWetStart[5] = 0.0f;
+  const std::vector<float> w = clothWetness(s.model, s.state);
+  ASSERT_EQ(w.size(), size_t(s.model.numCloth));
+  EXPECT_EQ(w[3], 0.0f);
+  EXPECT_NEAR(w[4], 1.0 - std::exp(-2.0 / 4.8936), 1e-6);
+  EXPECT_NEAR(w[5], 1.0 - std::exp(-10.0 / 4.8936), 1e-6);
+  EXPECT_EQ(w[6], 0.0f);
+  Model notWetted = s.model;
+  notWetted.pieces[0].wetByContact = false;
+  for (float v : clothWetness(notWetted, s.state)) EXPECT_EQ(v, 0.0f);
+}
+
+// a sheet solved implicitly next to a PBD sheet that gains saturation mass
+const char* kTwoPieces = R"({
+  "solver": {"dt": 0.01, "domain": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
+  "cloth": [{"name": "implicit", "solver": "implicit", "fabric": "cotton",
+             "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.2, 0.2], "resolution": [5, 5]},
+             "material": {"particleMass": 2e-4}, "pin": {"corners": [0, 1]}},
+            {"name": "pbd", "fabric": "high_absorption", "saturation": {"enabled": true},
+             "mesh": {"type": "rectangle", "center": [0, 0.5, 0], "size": [0.2, 0.2], "resolution": [4, 4]},
+             "material": {"particleMass": 1e-3}}],
+  "emitters": [{"type": "rain", "origin": [0, 1.3, 0], "halfExtents": [0.25, 0.25]}]
+})";
+
+// solveGarments: one implicit solve per implicit piece (counted), its result remembered in `solved`; a
+// PBD piece with saturation mass gets m_dry (1 + Q) from its own wet times and is not moved
+TEST(GarmentStage, SolveGarmentsSolvesImplicitPiecesAndWeighsPbdOnes) {
+  Scene s = fromString(kTwoPieces);
+  const Model& m = s.model;
+  ASSERT_EQ(m.numCloth, 25 + 16);
+  ASSERT_EQ(s.state.clothWetStart.size(), size_t(m.numCloth));
+  Particles& p = s.state.particles;
+  p.xPred = p.x;
+  s.state.time = 3.0;
+  s.state.clothWetStart[25] = 1.0f;  // the PBD piece's vertex 0, wet for 2 s
+  const std::vector<Vec3> pbdBefore(p.xPred.begin() + 25, p.xPred.end());
+  GarmentScratch gs;
+  StepStats stats;
+  std::vector<ColliderPose> poses;
+  solveGarments(m, s.state, gs, poses, 0.01f, stats);
+  EXPECT_EQ(stats.garment.solves, 1u);
+  EXPECT_GT(stats.garment.cgIterations, 0u);
+  ASSERT_EQ(gs.solved.size(), size_t(m.numCloth));
+  for (int i = 0; i < 25; ++i) EXPECT_EQ(gs.solved[size_t(i)], p.xPred[size_t(i)]) << i;
+  EXPECT_LT(p.xPred[12].y(), p.x[12].y()) << "the implicit sheet falls under gravity";
+  for (int i = 25; i < m.numCloth; ++i) EXPECT_EQ(p.xPred[size_t(i)], pbdBefore[size_t(i - 25)]) << i;
+  const double q = 2.492 * (1.0 - std::exp(-2.0 / 3.3803));
+  EXPECT_NEAR(p.mass[25], m.clothDryMass[25] * (1.0 + q), 1e-6 * p.mass[25]);
+  EXPECT_EQ(p.mass[26], m.clothDryMass[26]);
+}
+
+// the water coupling's push on an implicit piece: with drops vanishing (no Shao wetting) it is undone (the
+// drops do not push the garment); otherwise it becomes velocity, (x* - solved) / h. PBD cloth is left alone
+TEST(GarmentStage, CouplingPushBecomesVelocityUnlessDropsVanish) {
+  Scene s = fromString(kTwoPieces);
+  Model& m = s.model;
+  Particles& p = s.state.particles;
+  p.xPred = p.x;
+  GarmentScratch gs;
+  gs.solved = p.xPred;
+  const Vec3 push(0.001f, -0.002f, 0.0005f);
+  for (Vec3& x : p.xPred) x += push;
+  const std::vector<Vec3> v0 = p.v, pushed = p.xPred;
+  const float h = 0.005f;
+  addCouplingVelocity(m, p, gs, h);
+  for (int i = 0; i < 25; ++i) {
+    EXPECT_EQ(p.xPred[size_t(i)], gs.solved[size_t(i)]) << i;
+    EXPECT_EQ(p.v[size_t(i)], v0[size_t(i)]) << i;
+  }
+  for (int i = 25; i < m.numCloth; ++i) EXPECT_EQ(p.xPred[size_t(i)], pushed[size_t(i)]) << "PBD cloth, " << i;
+  m.pieces[0].dropsVanish = false;
+  p.xPred = pushed;
+  addCouplingVelocity(m, p, gs, h);
+  for (int i = 0; i < 25; ++i) {
+    EXPECT_EQ(p.xPred[size_t(i)], pushed[size_t(i)]) << i;
+    EXPECT_LT((p.v[size_t(i)] - (v0[size_t(i)] + push / h)).norm(), 1e-4f) << i;
+  }
+  for (int i = 25; i < m.numCloth; ++i) EXPECT_EQ(p.v[size_t(i)], v0[size_t(i)]) << "PBD cloth, " << i;
+}
+
+// section 3.5: a procedural garment's panels are its wrinkle subdomains (one per panel, each holding
+// exactly that panel's vertices); a plain sheet gets patches covering every vertex once
+TEST(GarmentStage, GarmentPanelsAreTheWrinkleSubdomains) {
+  const Scene s = fromString(R"({
+    "colliders": [{"name": "body", "type": "mannequin", "pose": {"shoulderAbduction": [45, 45]}}],
+    "cloth": [{"name": "shirt", "solver": "implicit", "mesh": {"type": "garment", "body": "body", "edgeLength": 0.05}}],
+    "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [0.5, 0.3]}]})");
+  const ClothPiece& piece = s.model.pieces[0];
+  ASSERT_TRUE(piece.implicit);
+  const std::vector<std::vector<int>>& sub = piece.implicit->subdomains;
+  ASSERT_EQ(sub.size(), 4u);  // front, back, two sleeves
+  size_t covered = 0;
+  for (size_t k = 0; k < sub.size(); ++k) {
+    for (int v : sub[k]) EXPECT_EQ(piece.panelOfVertex[size_t(v)], int(k)) << v;
+    covered += sub[k].size();
+  }
+  EXPECT_EQ(covered, size_t(piece.particleCount));
+
+  const Scene sheet = fromString(kSheet);
+  std::set<int> seen;
+  size_t total = 0;
+  for (const std::vector<int>& patch : sheet.model.pieces[0].implicit->subdomains) {
+    total += patch.size();
+    seen.insert(patch.begin(), patch.end());
+  }
+  EXPECT_EQ(total, 121u);
+  EXPECT_EQ(seen.size(), 121u);
+}
+
+TEST(GarmentRun, RainWetsTheGarmentByQAndEveryDropIsAccounted) {
+  Scene s = fromString(kSheet);
+  const Model& m = s.model;
+  StepStats total;
+  run(m, s.state, 40, &total);  // 0.67 s
+  const State& st = s.state;
+  int wet = 0;
+  const SaturationParams sat = m.pieces[0].garment.saturation;
+  for (int i = 0; i < m.numCloth; ++i) {
+    const float start = st.clothWetStart[size_t(i)];
+    if (!std::isfinite(start)) {
+      if (!m.clothPinned[size_t(i)]) EXPECT_FLOAT_EQ(st.particles.mass[size_t(i)], m.clothDryMass[size_t(i)]);
+      continue;
+    }
+    ++wet;
+    // Eq. 18: the mass set before the last solve is m_dry (1 + Q(t - t_wet)) at that time
+    const double t = st.time - m.solver.dt / m.solver.substeps;
+    EXPECT_NEAR(st.particles.mass[size_t(i)], wetMass(m.clothDryMass[size_t(i)], start, t, sat), 1e-9);
+  }
+  EXPECT_GT(wet, m.numCloth / 2);
+  EXPECT_GT(st.ledger.particlesTakenByCloth, 50u);
+  EXPECT_EQ(total.garment.dropsTaken, st.ledger.particlesTakenByCloth);
+  const WaterMass w = waterMass(st);
+  EXPECT_GT(w.emitted, 0.0);
+  EXPECT_NEAR(w.total, w.emitted, 1e-9 * w.emitted);
+  EXPECT_EQ(total.garment.solves, 80u);  // one per substep
+  EXPECT_EQ(total.garment.unconverged, 0u);
+}
+
+TEST(GarmentRun, DropsThatDoNotVanishStillWetAndStay) {
+  Scene s = fromString(kSheet, {"cloth.0.saturation.dropsVanish=false", "emitters.0.end=0.3"});
+  run(s.model, s.state, 25);
+  EXPECT_EQ(s.state.ledger.particlesTakenByCloth, 0u);
+  int wet = 0;
+  for (float t : s.state.clothWetStart) wet += std::isfinite(t) ? 1 : 0;
+  EXPECT_GT(wet, 10);
+}
+
+TEST(GarmentRun, CgStoppedAtItsCapIsCountedNotHidden) {
+  Scene s = fromString(kSheet, {"cloth.0.garment.cg.maxIterations=2"});
+  StepStats total;
+  run(s.model, s.state, 3, &total);
+  EXPECT_EQ(total.garment.solves, 6u);
+  EXPECT_GE(total.garment.unconverged, 4u);  // the first solve from rest may need fewer
+  EXPECT_EQ(total.garment.cgIterationsMax, 2);
+  EXPECT_GT(total.garment.maxResidual, 1e-5);
+}
+
+TEST(GarmentRun, WetMassMakesAPbdClothHeavierToo) {
+  // the saturation mass on a PBD piece: same rain, PBD solver
+  Scene s = fromString(R"({
+    "solver": {"dt": 0.0166667, "substeps": 2, "domain": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
+    "cloth": [{"mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.4, 0.4], "resolution": [11, 11]},
+               "material": {"particleMass": 2e-4}, "pin": {"corners": [0, 1, 2, 3]},
+               "saturation": {"enabled": true, "timeScale": 0.05}}],
+    "emitters": [{"type": "rain", "origin": [0, 1.3, 0], "halfExtents": [0.25, 0.25], "rate": 3000,
+                  "dropRadius": 0.002, "dropSpeed": 2.0, "start": 0.1, "end": 0.8}]})");
+  run(s.model, s.state, 40);
+  double mass = 0.0, dry = 0.0;
+  for (int i = 0; i < s.model.numCloth; ++i) {
+    if (s.model.clothPinned[size_t(i)]) continue;
+    mass += s.state.particles.mass[size_t(i)];
+    dry += s.model.clothDryMass[size_t(i)];
+  }
+  // cotton delta = 0.84; with a3 scaled to 0.44 s the cloth wet early is near saturation
+  EXPECT_GT(mass, 1.2 * dry);
+  EXPECT_LT(mass, 1.84 * dry + 1e-9);
+}
+
+// Fig. 8 of Chen 2012, scaled down: the same silk on the same (still) ball, dry and soaked; the wet
+// cloth is heavier (Eq. 15-19) and hangs lower (its mean height; the lowest point depends on how
+// the folds fall and is not compared)
+TEST(GarmentRun, WetSilkOnTheBallHangsLowerThanDry) {
+  const std::string dir = std::string(SOAK_SOURCE_DIR) + "/scenes/";
+  const std::vector<std::string> smaller = {"cloth.0.mesh.resolution=[21, 21]", "cloth.0.material.particleMass=3e-5",
+                                            "cloth.0.saturation.timeScale=0.1", "cloth.0.garment.stretch.a1=30", "cloth.0.garment.cg.tolerance=1e-5",
+                                            R"(colliders.0.keyframes=[{"time": 0, "position": [0, 0.5, 0]}])"};
+  Scene dry = loadScene(dir + "chen_fig8_silk_sphere_dry.json", smaller);
+  std::vector<std::string> wetSet = smaller;
+  wetSet.push_back("cloth.0.saturation.wetAtStart=true");
+  Scene wet = loadScene(dir + "chen_fig8_silk_sphere_wet.json", wetSet);
+  const int steps = 60;  // 1 s: both have settled (their mean height changes by < 0.5 mm after)
+  run(dry.model, dry.state, steps);
+  run(wet.model, wet.state, steps);
+  for (int i = 0; i < wet.model.numCloth; ++i)  // Q(1 s) with a3 = 0.88 s: 0.57 of delta
+    EXPECT_NEAR(wet.state.particles.mass[size_t(i)], 3e-5 * (1.0 + 0.84 * (1.0 - std::exp(-59.5 / 60 / 0.8844))), 1e-7);
+  const double yDry = meanHeight(dry.model, dry.state), yWet = meanHeight(wet.model, wet.state);
+  EXPECT_LT(yWet, yDry - 0.002) << "dry " << yDry << " wet " << yWet;
+
+  // both rest on the ball (radius 0.12 at y = 0.5): nothing fell through
+  for (const Scene* s : {&dry, &wet})
+    for (int i = 0; i < s->model.numCloth; ++i)
+      EXPECT_GT((s->state.particles.x[size_t(i)] - Vec3(0, 0.5f, 0)).norm(), 0.12f) << i;
+}
+
+// Fig. 2 / 9 of Chen 2012: the procedural T-shirt settles on the mannequin without going into it
+// by more than the cloth's thickness
+TEST(GarmentRun, GarmentDoesNotPenetrateTheMannequin) {
+  Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_wet.json",
+                      {"cloth.0.mesh.edgeLength=0.045", "emitters.0.end=1.0"});
+  const Model& m = s.model;
+  StepStats total;
+  run(m, s.state, 60, &total);  // 1 s
+  const float thickness = m.pieces[0].material.thickness;
+  float worst = 1e30f;
+  for (int i = 0; i < m.numCloth; ++i)
+    worst = std::min(worst, bodyDistance(m.colliders, s.state.time, s.state.particles.x[size_t(i)], nullptr));
+  EXPECT_GT(worst, -thickness);
+  EXPECT_GT(total.garment.contacts, 0u);  // it does rest on the body
+  // the shirt stays on: its lowest point is still above the hips' height minus a hand
+  double lowest = 1e30;
+  for (int i = 0; i < m.numCloth; ++i) lowest = std::min(lowest, double(s.state.particles.x[size_t(i)].y()));
+  EXPECT_GT(lowest, 0.6);
+}
+
+TEST(GarmentRun, SameStateForOneAndTwoThreads) {
+  auto hashWith = [](int threads) {
+    setThreadCount(threads);
+    Scene s = fromString(kSheet, {"emitters.0.end=0.4"});
+    run(s.model, s.state, 25);
+    return stateHash(s.state);
+  };
+  const uint64_t one = hashWith(1);
+  const uint64_t two = hashWith(2);
+  setThreadCount(2);
+  EXPECT_EQ(one, two);
+}
+
+}  // namespace
+}  // namespace soak

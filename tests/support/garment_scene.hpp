@@ -1,0 +1,61 @@
+// helpers for the tests of Chen 2012 scenes (tests/garment/stage_test.cpp, tests/scene/chen_keys_test.cpp):
+// a small implicit sheet under rain, loading from a string as "garment.json", the load error, and a run
+#pragma once
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
+#include <soak/step.hpp>
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace soak::testing {
+
+#ifndef EXPECT_HAS
+#define EXPECT_HAS(haystack, needle) EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+#endif
+
+// an implicit 0.4 m sheet of 11 x 11 vertices hung by two corners, with rain over it
+inline const char* kSheet = R"({
+  "solver": {"dt": 0.0166667, "substeps": 2, "domain": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
+  "cloth": [{"name": "sheet", "solver": "implicit", "fabric": "coarse_wool",
+             "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.4, 0.4], "resolution": [11, 11]},
+             "material": {"particleMass": 2e-4, "thickness": 0.008},
+             "pin": {"corners": [0, 1, 2, 3]},
+             "garment": {"stretch": {"a1": 500, "a2": 3}, "cg": {"tolerance": 1e-5, "maxIterations": 400}}}],
+  "emitters": [{"name": "rain", "type": "rain", "origin": [0, 1.3, 0], "halfExtents": [0.25, 0.25],
+                "rate": 3000, "dropRadius": 0.002, "dropSpeed": 2.0, "start": 0.1, "end": 0.8}]
+})";
+
+inline Scene fromString(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  return loadSceneFromString(text, "garment.json", ".", overrides);
+}
+
+// the message of the soak::Error thrown by loading `text`, or "" when it loads
+inline std::string loadError(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    fromString(text, overrides);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// `steps` steps of the scene's dt; the garment statistics summed into *total
+inline void run(const Model& model, State& state, int steps, StepStats* total = nullptr) {
+  WorkspacePtr ws = makeWorkspace();
+  for (int s = 0; s < steps; ++s) {
+    StepStats st;
+    step(model, state, *ws, model.solver.dt, st);
+    if (total) total->garment += st.garment;
+  }
+}
+
+inline double meanHeight(const Model& model, const State& state) {
+  double y = 0.0;
+  for (int i = 0; i < model.numCloth; ++i) y += state.particles.x[size_t(i)].y();
+  return y / model.numCloth;
+}
+
+}  // namespace soak::testing
