@@ -1,5 +1,5 @@
-// soak render and soak surface end to end (the soak binary, POV-Ray, ffmpeg) and the pieces they use:
-// camera framing, saturation colours, colliders at their keyframed pose, clear errors, no hang
+// soak render and soak surface end to end (the soak binary, POV-Ray, ffmpeg): pictures of the requested
+// size, saturation colours, clear errors, no hang (the POV-Ray scene text and the camera: pov_test.cpp)
 #include <soak/render.hpp>
 
 #include "render/pov.hpp"
@@ -22,36 +22,15 @@
 #include "render/pov.hpp"
 #include "render/process.hpp"
 #include "render/run_output.hpp"
+#include "render/render_support.hpp"
 #include "world/colliders.hpp"
 
 namespace soak {
 namespace {
 
-namespace fs = std::filesystem;
+using soak::testing::kTinyScene;
 
-// a wet 10 x 10 cloth pinned at its corners under a 4 x 4 x 4 block, a floor, a ball and a crate that
-// rises and turns; 3 frames of 2 steps
-constexpr const char* kTinyScene = R"({
-  "name": "tiny_render",
-  "description": "render test",
-  "solver": {"dt": 0.01, "substeps": 1, "domain": {"min": [-1, -1, -1], "max": [1, 2, 1]}},
-  "output": {"frames": 3, "stepsPerFrame": 2},
-  "wetting": {},
-  "cloth": [{
-    "name": "sheet",
-    "mesh": {"type": "rectangle", "center": [0, 0.5, 0], "size": [0.2, 0.2], "resolution": [10, 10],
-             "axisU": [1, 0, 0], "axisV": [0, 0, 1]},
-    "pin": {"corners": [0, 1, 2, 3]}
-  }],
-  "colliders": [
-    {"name": "ground", "type": "plane", "position": [0, 0, 0]},
-    {"name": "ball", "type": "sphere", "radius": 0.05, "position": [0.2, 0.05, 0]},
-    {"name": "crate", "type": "box", "halfExtents": [0.05, 0.05, 0.05],
-     "keyframes": [{"time": 0, "position": [-0.2, 0.05, 0]},
-                   {"time": 0.06, "position": [-0.2, 0.25, 0], "rotation": {"axis": [0, 1, 0], "degrees": 45}}]}
-  ],
-  "emitters": [{"name": "cube", "type": "block", "min": [-0.04, 0.54, -0.04], "max": [0.04, 0.62, 0.04]}]
-})";
+namespace fs = std::filesystem;
 
 // a wet cloth alone, for pictures of known saturation
 constexpr const char* kClothScene = R"({
@@ -300,119 +279,6 @@ TEST(SurfaceRun, WritesObjPlyAndVdbPerFrame) {
   }
   EXPECT_FALSE(fs::exists(fs::path(out) / "water_surface_0000.obj"));
   EXPECT_NE(r.out.find("wrote the water surface of frames 1..2"), std::string::npos) << r.out;
-}
-
-TEST(RenderCamera, AutomaticFramingShowsEveryCornerAndFillsThePicture) {
-  Bounds b;
-  b.add(Vec3(-1.2f, -0.5f, -0.3f));
-  b.add(Vec3(0.8f, 1.6f, 0.4f));
-  for (float az : {0.0f, 35.0f, 120.0f, -70.0f})
-    for (float el : {10.0f, 25.0f, 60.0f})
-      for (auto [w, h] : {std::pair{640, 480}, std::pair{300, 600}}) {
-        CameraRequest req;
-        req.azimuthDegrees = az;
-        req.elevationDegrees = el;
-        const CameraSpec cam = frameCamera(b, req, w, h);
-        const Vec3 fwd = (cam.lookAt - cam.position).normalized();
-        const Vec3 right = fwd.cross(Vec3(0, 1, 0)).normalized();
-        const Vec3 up = right.cross(fwd);
-        const float tanH = std::tan(0.5f * cam.fovDegrees * kPi / 180.0f), tanV = tanH * float(h) / float(w);
-        float widest = 0.0f;
-        for (int k = 0; k < 8; ++k) {
-          const Vec3 p((k & 1) ? b.hi.x() : b.lo.x(), (k & 2) ? b.hi.y() : b.lo.y(), (k & 4) ? b.hi.z() : b.lo.z());
-          const Vec3 d = p - cam.position;
-          const float depth = d.dot(fwd);
-          ASSERT_GT(depth, 0.0f);
-          const float sx = d.dot(right) / depth / tanH, sy = d.dot(up) / depth / tanV;
-          EXPECT_LE(std::abs(sx), 1.0f) << az << " " << el;
-          EXPECT_LE(std::abs(sy), 1.0f) << az << " " << el;
-          widest = std::max({widest, std::abs(sx), std::abs(sy)});
-        }
-        EXPECT_GT(widest, 0.85f) << "the bounds should fill the picture, az " << az << " el " << el;
-      }
-}
-
-TEST(RenderCamera, EveryPointAddedIsInThePictureAndZoomMovesCloser) {
-  // a cloud of points with radii (water particles), one stray drop far to the side
-  CameraRequest req;
-  CameraFit fit(req, 480, 360);
-  std::vector<std::pair<Vec3, float>> pts;
-  uint32_t seed = 12345;
-  auto rnd = [&seed] {
-    seed = seed * 1664525u + 1013904223u;
-    return float(seed >> 8) / float(1 << 24);
-  };
-  for (int i = 0; i < 500; ++i) pts.push_back({Vec3(rnd() - 0.5f, 2.0f * rnd(), rnd() - 0.5f), 0.02f});
-  pts.push_back({Vec3(1.4f, 0.1f, -0.9f), 0.0125f});
-  for (const auto& [p, r] : pts) fit.add(p, r);
-  const CameraSpec cam = fit.camera();
-  const Vec3 fwd = (cam.lookAt - cam.position).normalized();
-  const Vec3 right = fwd.cross(Vec3(0, 1, 0)).normalized();
-  const Vec3 up = right.cross(fwd);
-  const float tanH = std::tan(0.5f * cam.fovDegrees * kPi / 180.0f), tanV = tanH * 360.0f / 480.0f;
-  float widest = 0.0f;
-  for (const auto& [p, r] : pts) {
-    const Vec3 d = p - cam.position;
-    const float depth = d.dot(fwd);
-    // the ball's silhouette edge: centre offset plus its radius
-    const float sx = (std::abs(d.dot(right)) + r) / depth / tanH, sy = (std::abs(d.dot(up)) + r) / depth / tanV;
-    EXPECT_LE(sx, 1.0f);
-    EXPECT_LE(sy, 1.0f);
-    widest = std::max({widest, sx, sy});
-  }
-  EXPECT_GT(widest, 0.85f);
-  req.zoom = 2.0f;
-  CameraFit closer(req, 480, 360);
-  for (const auto& [p, r] : pts) closer.add(p, r);
-  const CameraSpec zoomed = closer.camera();
-  EXPECT_NEAR((zoomed.position - zoomed.lookAt).norm(), 0.5f * (cam.position - cam.lookAt).norm(), 1e-4f);
-  EXPECT_EQ(zoomed.lookAt, cam.lookAt);
-}
-
-TEST(RenderCamera, UserCameraIsKept) {
-  Bounds b;
-  b.add(Vec3(0, 0, 0), 1.0f);
-  CameraRequest req;
-  req.position = Vec3(3, 2, 1);
-  req.lookAt = Vec3(0, 0.5f, 0);
-  req.fovDegrees = 30.0f;
-  const CameraSpec cam = frameCamera(b, req, 100, 100);
-  EXPECT_EQ(cam.position, Vec3(3, 2, 1));
-  EXPECT_EQ(cam.lookAt, Vec3(0, 0.5f, 0));
-  EXPECT_EQ(cam.fovDegrees, 30.0f);
-}
-
-TEST(RenderScene, CollidersAreDrawnAtTheirKeyframedPose) {
-  const Scene scene = loadSceneFromString(kTinyScene, "tiny.json", ".");
-  const Collider& crate = scene.model.colliders[2];
-  // at the first key: a 0.1 m cube at (-0.2, 0.05, 0); at the last: raised to 0.25 and turned 45 degrees
-  const Bounds start = colliderBounds(crate, colliderPose(crate, 0.0));
-  EXPECT_NEAR(start.lo.y(), 0.0f, 1e-5f);
-  EXPECT_NEAR(start.hi.x() - start.lo.x(), 0.1f, 1e-5f);
-  const Bounds end = colliderBounds(crate, colliderPose(crate, 0.06));
-  EXPECT_NEAR(end.lo.y(), 0.2f, 1e-5f);
-  EXPECT_NEAR(end.hi.x() - end.lo.x(), 0.1f * std::sqrt(2.0f), 1e-4f);
-  EXPECT_TRUE(colliderBounds(scene.model.colliders[0], colliderPose(scene.model.colliders[0], 0.0)).empty());
-
-  PovFrameInput in;
-  in.model = &scene.model;
-  for (const Collider& c : scene.model.colliders) in.poses.push_back(colliderPose(c, 0.06));
-  const std::string pov = povScene(in);
-  EXPECT_NE(pov.find("plane { <0,1,0>, 0 texture { Floor } }"), std::string::npos);
-  EXPECT_NE(pov.find("sphere { <0,0,0>, 0.05"), std::string::npos);
-  EXPECT_NE(pov.find(", -0.2,0.25,0>"), std::string::npos) << pov;  // the crate's matrix ends with its position
-  EXPECT_NE(pov.find("right -x*"), std::string::npos);              // right-handed data in POV-Ray
-}
-
-TEST(RenderScene, SaturationRampsOfThePaper) {
-  EXPECT_EQ(rampColor("red", 0.0f, 0.4f), Vec3(1, 0, 0));
-  EXPECT_EQ(rampColor("green", 0.0f, 0.4f), Vec3(0, 1, 0));
-  EXPECT_EQ(rampColor("red", 0.4f, 0.4f), Vec3(0, 0, 0));
-  EXPECT_EQ(rampColor("red", 0.9f, 0.4f), Vec3(0, 0, 0));
-  EXPECT_NEAR(rampColor("green", 0.1f, 0.4f).y(), 0.75f, 1e-6f);
-  ClothFrame plain;
-  plain.x.assign(3, Vec3::Zero());
-  EXPECT_TRUE(clothColors(plain, "red", 0.4f).empty());  // no saturation: the plain fabric colour
 }
 
 }  // namespace
