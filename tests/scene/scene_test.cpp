@@ -1,5 +1,6 @@
-// scene loading: shipped scenes load and match the paper's figures, defaults are Table 1, overrides
-// apply, pins land on the right particles, and every documented error names the file and JSON path
+// scene loading: shipped scenes load and match the paper's figures, defaults are Table 1, pins land on
+// the right particles, and every documented error names the file and JSON path (the overrides and the
+// JSON text layer: overrides_test.cpp)
 #include <soak/error.hpp>
 #include <soak/scene.hpp>
 
@@ -9,59 +10,14 @@
 #include <filesystem>
 #include <fstream>
 
+#include "scene/scene_support.hpp"
 #include "world/colliders.hpp"
 #include "world/emitters.hpp"
 
 namespace soak {
 namespace {
 
-namespace fs = std::filesystem;
-
-// a small valid scene: one 4 x 3 rectangle, one block emitter
-const char* kSmall = R"({
-  "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.3, 0.2],
-                                      "resolution": [4, 3]}}],
-  "emitters": [{"type": "block", "min": [-0.05, 1.2, -0.05], "max": [0.05, 1.3, 0.05]}]
-})";
-
-Scene fromString(const std::string& text, const std::vector<std::string>& overrides = {},
-                 const std::string& baseDir = ".") {
-  return loadSceneFromString(text, "test.json", baseDir, overrides);
-}
-
-// the message of the soak::Error thrown by loading `text`, or "" when it loads
-std::string loadError(const std::string& text, const std::vector<std::string>& overrides = {},
-                      const std::string& baseDir = ".") {
-  try {
-    fromString(text, overrides, baseDir);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
-// the error of loading kSmall with one "path=value" override applied
-std::string errorWith(const std::string& override_) { return loadError(kSmall, {override_}); }
-
-// a fresh directory under the system temp dir, removed at the end of the test
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() / ("soak_scene_" + std::string(info->name()) + "_" + std::to_string(getpid()));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-    return (path / name).string();
-  }
-};
-
-#define EXPECT_HAS(haystack, needle) EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+using namespace soak::testing;
 
 TEST(SceneFiles, EveryShippedSceneLoadsWithADescription) {
   int count = 0;
@@ -226,32 +182,6 @@ TEST(SceneBuild, CollidersAndEmittersAreRead) {
   EXPECT_EQ(s.state.particles.size(), 0u);  // emitters do not run at load
 }
 
-TEST(SceneOverrides, ChangeValuesBeforeValidation) {
-  const Scene s = fromString(kSmall, {"solver.substeps=3", "cloth.0.material.thickness=0.02", "water.tensile.k=0.25",
-                                      "output.water=false", "name=my run", "description=\"quoted\"",
-                                      "cloth.0.pin.corners=[0, 3]"});
-  EXPECT_EQ(s.model.solver.substeps, 3);
-  EXPECT_FLOAT_EQ(s.model.pieces[0].material.thickness, 0.02f);
-  EXPECT_FLOAT_EQ(s.model.water.tensileK, 0.25f);
-  EXPECT_FALSE(s.output.water);
-  EXPECT_EQ(s.name, "my run");  // not JSON: taken as a string
-  EXPECT_EQ(s.description, "quoted");
-  int pinned = 0;
-  for (uint8_t p : s.model.clothPinned) pinned += p;
-  EXPECT_EQ(pinned, 2);
-  // an override is validated like the file itself
-  EXPECT_HAS(errorWith("solver.substeps=0"), "test.json: at solver.substeps: expected an integer >= 1, got 0");
-}
-
-TEST(SceneErrors, BadOverridesNameTheOverride) {
-  EXPECT_HAS(errorWith("solver.substeps"), "test.json: at override 'solver.substeps': expected \"path=value\"");
-  EXPECT_HAS(errorWith("cloth.3.name=x"), "at override 'cloth.3.name=x': index 3 is past the end of 'cloth' (1 elements)");
-  EXPECT_HAS(errorWith("cloth.0.name.x=1"), "at override 'cloth.0.name.x=1': 'cloth.0.name' is a string, it has no key 'x'");
-  EXPECT_HAS(errorWith("cloth.first=1"), "'cloth' is an array: expected an index, got 'first'");
-  EXPECT_HAS(errorWith("solver..dt=1"), "at override 'solver..dt=1': expected a path of non-empty components");
-  EXPECT_HAS(errorWith("colliders.0.type=box"), "index 0 is past the end of 'colliders'");
-}
-
 TEST(SceneErrors, UnknownKeysAtTopLevelAndNested) {
   EXPECT_HAS(errorWith("solvr.dt=1"), "test.json: at solvr: unknown key 'solvr' (known: name, description, solver,");
   EXPECT_HAS(errorWith("solvr.dt=1"), "did you mean 'solver'?");
@@ -388,34 +318,6 @@ TEST(SceneErrors, NonManifoldObjIsRefusedWithFileAndPath) {
     EXPECT_HAS(msg, scene + ": at cloth[0].mesh");
     EXPECT_HAS(msg, "shared by 3 triangles");
   }
-}
-
-TEST(SceneErrors, ARepeatedKeyIsNamedWithItsPath) {
-  // JSON parsers keep the last of two equal keys: the first value would be lost without a word
-  EXPECT_HAS(loadError(R"({"solver": {"dt": 0.015, "substeps": 2, "dt": 0.01}})"),
-             "test.json: at solver.dt: expected each key once in its object, got it twice");
-  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle"}},
-                                     {"mesh": {"type": "rectangle"}, "material": {"thickness": 0.01, "thickness": 0.02}}]})"),
-             "test.json: at cloth[1].material.thickness: expected each key once");
-  // the same key in two objects is not a repeat
-  EXPECT_EQ(loadError(R"({"cloth": [{"name": "a", "mesh": {"type": "rectangle", "size": [0.2, 0.2], "resolution": [3, 3]}},
-                                    {"name": "b", "mesh": {"type": "rectangle", "size": [0.2, 0.2], "resolution": [3, 3]}}]})"),
-            "");
-}
-
-TEST(SceneErrors, JsonSyntaxErrorNamesLineAndColumn) {
-  const std::string msg = loadError("{\n  \"solver\": {\n    \"dt\": 0.01,\n  }\n}\n");
-  EXPECT_HAS(msg, "test.json: at line 4, column 3: invalid JSON: syntax error");
-  TempDir dir;
-  const std::string path = dir.write("broken.json", "{\"cloth\": [\n\n  {\"mesh\" {}}\n]}");
-  try {
-    loadScene(path);
-    FAIL() << "broken JSON loaded";
-  } catch (const Error& e) {
-    EXPECT_HAS(std::string(e.what()), path + ": at line 3, column");
-  }
-  // comments are allowed
-  EXPECT_EQ(loadError(std::string("// a comment\n") + kSmall), "");
 }
 
 TEST(SceneErrors, FileErrorsNameTheFile) {
