@@ -52,24 +52,6 @@ TEST(WettingParams, DefaultsAreTable1AndASectionTurnsWettingOn) {
   EXPECT_TRUE(absent.state.clothWater.empty());
 }
 
-TEST(WettingParams, InitialSaturationFillsTheClothAndCountsAsEmitted) {
-  const Scene s = sceneFromJson(kHanging, {"wetting.saturation.initial=0.4"});
-  const std::vector<float> v = restVolumes(s.model, s.state.particles.radius);
-  double expected = 0.0;
-  for (float vi : v) expected += double(0.4f) * vi / s.model.wetting.c;
-  EXPECT_NEAR(sum(s.state.clothWater), expected, 1e-9 * expected);
-  EXPECT_NEAR(s.state.ledger.emitted, expected, 1e-9 * expected);
-  // an interior particle of a 0.02 m sheet: V = 1 / sum W = 1.28e-5 m^3, holding 5.1 g at S^MAX
-  const size_t mid = 10 * 21 + 10;
-  EXPECT_NEAR(v[mid], 1.2816e-5f, 2e-8f);
-  // the wet cloth is heavier: dry mass + held water; pinned corners stay kinematic
-  const Particles& p = s.state.particles;
-  EXPECT_NEAR(p.mass[mid], 0.0066f + 0.4f * v[mid] / 1.0e-3f, 1e-6f);
-  EXPECT_NEAR(p.invMass[mid], 1.0f / p.mass[mid], 1e-3f);
-  for (size_t i = 0; i < p.size(); ++i)
-    if (s.model.clothPinned[i]) EXPECT_EQ(p.invMass[i], 0.0f);
-}
-
 TEST(WettingParams, RefusesInconsistentSaturations) {
   const std::string sticky = errorOf({"wetting.saturation.sticky=0.35"});
   EXPECT_NE(sticky.find("<test>: at wetting.saturation.sticky: expected a number < wetting.saturation.emit"),

@@ -1,5 +1,5 @@
-// wet dynamics: the sticking force of Eq. 20 peaks at S^T and vanishes on dry and on soaked cloth;
-// the coupling stiffness of Eq. 22 falls with saturation
+// wet dynamics: the sticking force of Eq. 20 peaks at S^T and vanishes on dry and on soaked cloth (the
+// coupling stiffness of Eq. 22: permeability_test.cpp)
 #include "wetting/wet_support.hpp"
 
 #include <gtest/gtest.h>
@@ -63,16 +63,4 @@ TEST(WettingSticking, WetLayersPullTogetherMostAtST) {
   EXPECT_LT(damp, 0.0f);
   EXPECT_LT(atT, damp);  // stronger (more negative) at S^T
   EXPECT_LT(atT, pullOnUpperSheet(w.saturationEmit));
-}
-
-TEST(WettingPermeability, StiffnessFallsWithSaturation) {
-  const WettingParams w;
-  const float st = w.saturationSticky, sm = w.saturationMax;
-  EXPECT_EQ(couplingStiffness(w, 0.0f, 0.0f, 0.0f), 1.0f);
-  EXPECT_EQ(couplingStiffness(w, st, st, st), 1.0f);  // below S^T the cloth is as tight as dry
-  EXPECT_NEAR(couplingStiffness(w, sm, sm, sm), 0.0f, 1e-6f);
-  const float half = 0.5f * (st + sm);
-  EXPECT_NEAR(couplingStiffness(w, half, half, half), 0.5f, 1e-6f);
-  EXPECT_NEAR(couplingStiffness(w, sm, st, st), 2.0f / 3.0f, 1e-6f);
-  EXPECT_EQ(couplingStiffness(w, 1.0f, 1.0f, 1.0f), 0.0f);  // clamped
 }
