@@ -1,8 +1,8 @@
 // mannequin: height and ground contact, left/right symmetry, head above the shoulders, joints that
-// stay joined, keyed motion; garments: manifold (accepted as cloth), panels on every vertex, every
-// vertex outside the body by the margin and close to it
-#include "world/garment_mesh.hpp"
+// stay joined, keyed motion (the garments sewn around it: garment_mesh_test.cpp)
 #include "world/mannequin.hpp"
+
+#include "world/garment_mesh.hpp"  // bodyDistance
 
 #include "scene/cloth_piece.hpp"
 #include "world/colliders.hpp"
@@ -184,99 +184,6 @@ TEST(MannequinBody, RefusesBadParameters) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("scene.json"), std::string::npos);
   }
-}
-
-// the checks every garment must pass: accepted as cloth, every edge in one or two triangles, panels
-// on every vertex, every vertex outside the body by the margin and most of them near it
-void checkGarment(const Garment& g, const MannequinParams& mp, const GarmentPattern& gp, int panels) {
-  ASSERT_GT(g.mesh.vertices.size(), 200u);
-  Model model;
-  EXPECT_NO_THROW(addClothPiece(model, "garment", g.mesh, ClothMaterial{}, {}, "garment"));
-  std::map<std::pair<int, int>, int> edgeUse;
-  for (const auto& t : g.mesh.triangles)
-    for (int k = 0; k < 3; ++k) ++edgeUse[std::minmax(t[k], t[(k + 1) % 3])];
-  int open = 0;
-  for (const auto& [edge, n] : edgeUse) {
-    EXPECT_LE(n, 2);
-    open += n == 1;
-  }
-  EXPECT_GT(open, 20);  // hem, neck and sleeve / arm openings
-  ASSERT_EQ(g.panelOfVertex.size(), g.mesh.vertices.size());
-  ASSERT_EQ(static_cast<int>(g.panelNames.size()), panels);
-  std::vector<int> count(panels, 0);
-  for (int p : g.panelOfVertex) {
-    ASSERT_GE(p, 0);
-    ASSERT_LT(p, panels);
-    ++count[p];
-  }
-  for (int p = 0; p < panels; ++p) EXPECT_GT(count[p], 20) << g.panelNames[p];
-  // seams: edges whose two triangles lie on different panels exist (front and back are sewn)
-  const std::vector<Collider> body = buildMannequin(mp, {}, 0.5f);
-  EXPECT_TRUE(verticesInsideBody(g.mesh, body, 0.0, gp.margin).empty());
-  int near = 0;
-  for (const Vec3& x : g.mesh.vertices) near += bodyDistance(body, 0.0, x, nullptr) < 3.0f * (gp.margin + gp.ease);
-  EXPECT_GT(near, static_cast<int>(g.mesh.vertices.size()) / 2);  // it hugs the body
-}
-
-TEST(MannequinGarment, TShirtIsManifoldOutsideTheBodyWithFourPanels) {
-  MannequinParams mp;
-  mp.position = Vec3(0.5f, 0.0f, -1.0f);
-  mp.yaw = 0.4f;
-  const MannequinPose pose = aPose(0.8f);
-  mp.pose = pose;
-  GarmentPattern gp;
-  const Garment g = buildGarment(mp, pose, gp);
-  checkGarment(g, mp, gp, 4);
-  // the shirt spans from the hem to above the shoulders
-  const MannequinJoints j = mannequinJoints(mp, pose);
-  float lo = 1e30f, hi = -1e30f;
-  for (const Vec3& x : g.mesh.vertices) lo = std::min(lo, x.y()), hi = std::max(hi, x.y());
-  EXPECT_NEAR(lo, 0.48f * mp.height, 0.01f);
-  EXPECT_GT(hi, j.shoulder[kLeft].y());
-  // sleeve vertices sit around the upper arms
-  for (size_t v = 0; v < g.mesh.vertices.size(); ++v) {
-    if (g.panelOfVertex[v] != kPanelLeftSleeve) continue;
-    const Vec3 a = j.shoulder[kLeft], b = j.elbow[kLeft], x = g.mesh.vertices[v];
-    const float s = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0f, 1.0f);
-    EXPECT_LT((x - (a + s * (b - a))).norm(), 0.15f);
-  }
-}
-
-TEST(MannequinGarment, DressIsManifoldOutsideTheBodyDownToTheKnees) {
-  MannequinParams mp;
-  MannequinPose pose = aPose(0.4f);
-  pose.kneeFlexion = {0.2f, 0.0f};
-  mp.pose = pose;
-  GarmentPattern gp;
-  gp.style = GarmentStyle::Dress;
-  gp.edgeLength = 0.035f;
-  const Garment g = buildGarment(mp, pose, gp);
-  checkGarment(g, mp, gp, 2);
-  const MannequinJoints j = mannequinJoints(mp, pose);
-  float lo = 1e30f, widest = 0.0f;
-  for (const Vec3& x : g.mesh.vertices) lo = std::min(lo, x.y()), widest = std::max(widest, std::fabs(x.x()));
-  EXPECT_LT(lo, j.knee[kLeft].y());
-  EXPECT_GT(widest, 0.5f * mp.hipWidth * mp.height);  // the skirt flares past the hips
-}
-
-TEST(MannequinGarment, ArmsAtTheSidesAreRefused) {
-  MannequinParams mp;
-  const MannequinPose pose;  // arms hanging straight down
-  EXPECT_THROW(buildGarment(mp, pose, GarmentPattern{}), Error);
-  GarmentPattern bad;
-  bad.edgeLength = -0.01f;
-  EXPECT_THROW(buildGarment(mp, aPose(0.8f), bad), Error);
-}
-
-TEST(MannequinGarment, PushOutMovesInsideVerticesToTheMargin) {
-  MannequinParams mp;
-  const std::vector<Collider> body = buildMannequin(mp, {}, 0.5f);
-  TriangleMesh m;
-  m.vertices = {Vec3(0.0f, 1.2f, 0.0f), Vec3(0.05f, 0.9f, 0.02f), Vec3(1.0f, 1.0f, 1.0f)};
-  EXPECT_EQ(verticesInsideBody(m, body, 0.0, 0.01f), (std::vector<int>{0, 1}));
-  EXPECT_EQ(pushOutOfBody(m, body, 0.0, 0.01f), 0u);
-  EXPECT_TRUE(verticesInsideBody(m, body, 0.0, 0.01f).empty());
-  EXPECT_EQ(m.vertices[2], Vec3(1.0f, 1.0f, 1.0f));
 }
 
 }  // namespace
