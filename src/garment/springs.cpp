@@ -37,12 +37,11 @@ struct HalfEdge {
   int triangle;
 };
 
-}  // namespace
-
-SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::array<int, 3>>& triangles,
-                       const SpringBuildOptions& options) {
-  const int n = static_cast<int>(rest.size());
-  std::vector<double> triArea(triangles.size());
+// every triangle's three edges as (key, opposite vertex, triangle), sorted by edge then triangle,
+// and each triangle's rest area (m^2)
+std::vector<HalfEdge> sortedHalfEdges(const std::vector<Vec3>& rest, const std::vector<std::array<int, 3>>& triangles,
+                                      std::vector<double>& triArea) {
+  triArea.resize(triangles.size());
   std::vector<HalfEdge> half;
   half.reserve(triangles.size() * 3);
   for (size_t t = 0; t < triangles.size(); ++t) {
@@ -54,25 +53,33 @@ SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::arr
   std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
     return x.key != y.key ? x.key < y.key : x.triangle < y.triangle;
   });
+  return half;
+}
 
-  // stretch: unique edges, each with a third of the area of its triangles
-  std::vector<Candidate> stretch, shear, bend;
+// stretch: unique edges, each with a third of the area of its triangles (sorted by key, as `half`);
+// shear: the opposite vertices across an interior edge, with the edge's area share
+void stretchAndShear(const std::vector<HalfEdge>& half, const std::vector<double>& triArea,
+                     std::vector<Candidate>& stretch, std::vector<Candidate>& shear) {
   for (size_t s = 0; s < half.size();) {
     size_t e = s;
     double area = 0.0;
     while (e < half.size() && half[e].key == half[s].key) area += triArea[half[e++].triangle] / 3.0;
     const int a = static_cast<int>(half[s].key >> 32), b = static_cast<int>(half[s].key & 0xffffffff);
     stretch.push_back({half[s].key, a, b, static_cast<float>(area)});
-    // shear: the opposite vertices across an interior edge, with the edge's area share
     if (e - s == 2 && half[s].opposite != half[s + 1].opposite)
       shear.push_back({pairKey(half[s].opposite, half[s + 1].opposite), half[s].opposite, half[s + 1].opposite,
                        static_cast<float>(area)});
     s = e;
   }
-  std::vector<int64_t> taken;
-  for (const Candidate& c : stretch) taken.push_back(c.key);  // already sorted and unique
+}
 
-  // 1-ring with the index of the stretch spring of each edge, for the bend springs
+// bend: for every edge (a, b), the pair (a, c) with c the neighbour of b that continues a -> b most
+// straightly (cosine >= bendStraightness), with the mean area share of edges (a, b) and (b, c)
+std::vector<Candidate> bendCandidates(const std::vector<Vec3>& rest, const std::vector<Candidate>& stretch,
+                                      const SpringBuildOptions& options) {
+  const int n = static_cast<int>(rest.size());
+  std::vector<Candidate> bend;
+  // 1-ring with the index of the stretch spring of each edge
   std::vector<std::vector<std::pair<int, int>>> ring(n);
   for (int k = 0; k < static_cast<int>(stretch.size()); ++k) {
     ring[stretch[k].a].push_back({stretch[k].b, k});
@@ -97,15 +104,11 @@ SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::arr
         bend.push_back({pairKey(a, best), a, best, 0.5f * (stretch[ab].area + stretch[bestEdge].area)});
     }
   }
-  // a pair that is both a straight skip-one pair and a pair across an edge is a bend spring
-  bend = uniqueNotIn(std::move(bend), taken);
-  for (const Candidate& c : bend) taken.push_back(c.key);
-  std::sort(taken.begin(), taken.end());
-  shear = uniqueNotIn(std::move(shear), taken);
+  return bend;
+}
 
-  SpringSet out;
-  out.numVertices = n;
-  const std::vector<Candidate>* kinds[3] = {&stretch, &shear, &bend};
+// the springs of the three kinds in order, with rest length l0 and width L0 = S_r / l0 (Eq. 9)
+void appendSprings(SpringSet& out, const std::vector<Vec3>& rest, const std::vector<Candidate>* const kinds[3]) {
   for (int k = 0; k < 3; ++k) {
     out.kindStart[k] = out.size();
     for (const Candidate& c : *kinds[k]) {
@@ -117,7 +120,11 @@ SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::arr
     }
   }
   out.kindStart[3] = out.size();
+}
 
+// the CSR of the springs at each vertex (counts, prefix sums, then each spring in ascending order)
+void indexSpringsByVertex(SpringSet& out) {
+  const int n = out.numVertices;
   out.vertexStart.assign(n + 1, 0);
   for (const auto& id : out.ids) {
     ++out.vertexStart[id[0] + 1];
@@ -130,6 +137,30 @@ SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::arr
     out.vertexSpring[fill[out.ids[s][0]]++] = s;
     out.vertexSpring[fill[out.ids[s][1]]++] = s;
   }
+}
+
+}  // namespace
+
+SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::array<int, 3>>& triangles,
+                       const SpringBuildOptions& options) {
+  std::vector<double> triArea;
+  const std::vector<HalfEdge> half = sortedHalfEdges(rest, triangles, triArea);
+  std::vector<Candidate> stretch, shear;
+  stretchAndShear(half, triArea, stretch, shear);
+  std::vector<int64_t> taken;
+  for (const Candidate& c : stretch) taken.push_back(c.key);  // already sorted and unique
+  std::vector<Candidate> bend = bendCandidates(rest, stretch, options);
+  // a pair that is both a straight skip-one pair and a pair across an edge is a bend spring
+  bend = uniqueNotIn(std::move(bend), taken);
+  for (const Candidate& c : bend) taken.push_back(c.key);
+  std::sort(taken.begin(), taken.end());
+  shear = uniqueNotIn(std::move(shear), taken);
+
+  SpringSet out;
+  out.numVertices = static_cast<int>(rest.size());
+  const std::vector<Candidate>* const kinds[3] = {&stretch, &shear, &bend};
+  appendSprings(out, rest, kinds);
+  indexSpringsByVertex(out);
   return out;
 }
 
