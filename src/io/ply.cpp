@@ -224,13 +224,40 @@ class BodyReader {
   bool ascii_, big_;
 };
 
-}  // namespace
+// a "property" line of the header (ss past the word): a scalar type or "list COUNT ITEM", then the
+// name, added to the last element
+void readPropertyLine(std::istringstream& ss, const std::string& path, const std::string& where, PlyData& ply,
+                      std::vector<std::vector<PropertySpec>>& specs) {
+  if (ply.elements.empty()) throw Error(path + ": at " + where + ": property before any element");
+  PropertySpec spec;
+  std::string type;
+  ss >> type;
+  std::string typeName = type;
+  if (type == "list") {
+    std::string countType, itemType;
+    ss >> countType >> itemType;
+    spec.countType = parseType(countType);
+    spec.type = parseType(itemType);
+    if (spec.countType == PlyType::Invalid || spec.type == PlyType::Invalid)
+      throw Error(path + ": at " + where + ": unknown list types '" + countType + " " + itemType + "'");
+    typeName = "list " + countType + " " + itemType;
+  } else {
+    spec.type = parseType(type);
+    if (spec.type == PlyType::Invalid) throw Error(path + ": at " + where + ": unknown type '" + type + "'");
+  }
+  ss >> spec.name;
+  if (spec.name.empty()) throw Error(path + ": at " + where + ": property has no name");
+  PlyElement& e = ply.elements.back();
+  if (e.has(spec.name)) throw Error(path + ": at " + where + ": property '" + spec.name + "' defined twice");
+  e.propertyNames.push_back(spec.name);
+  e.propertyType[spec.name] = typeName;
+  specs.back().push_back(spec);
+}
 
-PlyData readPly(const std::string& path) {
-  const std::string data = readTextFile(path);
-  PlyData ply;
-  ply.path = path;
-  std::vector<std::vector<PropertySpec>> specs;
+// the header up to end_header: format, comments, the elements and their properties (specs, one list
+// per element); returns the offset of the body
+size_t readHeader(const std::string& data, const std::string& path, PlyData& ply,
+                  std::vector<std::vector<PropertySpec>>& specs) {
   size_t pos = 0;
   int lineNo = 0;
   bool ended = false;
@@ -265,30 +292,7 @@ PlyData readPly(const std::string& path) {
       ply.elements.push_back(std::move(e));
       specs.emplace_back();
     } else if (word == "property") {
-      if (ply.elements.empty()) throw Error(path + ": at " + where + ": property before any element");
-      PropertySpec spec;
-      std::string type;
-      ss >> type;
-      std::string typeName = type;
-      if (type == "list") {
-        std::string countType, itemType;
-        ss >> countType >> itemType;
-        spec.countType = parseType(countType);
-        spec.type = parseType(itemType);
-        if (spec.countType == PlyType::Invalid || spec.type == PlyType::Invalid)
-          throw Error(path + ": at " + where + ": unknown list types '" + countType + " " + itemType + "'");
-        typeName = "list " + countType + " " + itemType;
-      } else {
-        spec.type = parseType(type);
-        if (spec.type == PlyType::Invalid) throw Error(path + ": at " + where + ": unknown type '" + type + "'");
-      }
-      ss >> spec.name;
-      if (spec.name.empty()) throw Error(path + ": at " + where + ": property has no name");
-      PlyElement& e = ply.elements.back();
-      if (e.has(spec.name)) throw Error(path + ": at " + where + ": property '" + spec.name + "' defined twice");
-      e.propertyNames.push_back(spec.name);
-      e.propertyType[spec.name] = typeName;
-      specs.back().push_back(spec);
+      readPropertyLine(ss, path, where, ply, specs);
     } else if (word == "end_header") {
       ended = true;
     } else if (!word.empty()) {
@@ -296,42 +300,55 @@ PlyData readPly(const std::string& path) {
     }
   }
   if (ply.format.empty()) throw Error(path + ": header has no format line");
+  return pos;
+}
 
-  BodyReader body(path, data, pos, ply.format == "ascii", ply.format == "binary_big_endian");
-  for (size_t k = 0; k < ply.elements.size(); ++k) {
-    PlyElement& e = ply.elements[k];
-    const std::vector<PropertySpec>& props = specs[k];
-    // a corrupt count must not make us allocate far more than the file holds
-    size_t minBytes = 0;
-    for (const PropertySpec& s : props) minBytes += typeSize(s.countType == PlyType::Invalid ? s.type : s.countType);
-    if (ply.format != "ascii" && minBytes > 0 && e.count > body.remaining() / minBytes)
-      throw Error(fmt::format("{}: element '{}' declares {} items but the file is too short", path, e.name, e.count));
-    std::vector<std::vector<double>*> scalarOut(props.size(), nullptr);
-    for (size_t j = 0; j < props.size(); ++j) {
-      if (props[j].countType == PlyType::Invalid) {
-        scalarOut[j] = &e.scalars[props[j].name];
-        scalarOut[j]->reserve(e.count);
-      } else {
-        e.listStart[props[j].name].push_back(0);
-      }
-    }
-    for (size_t i = 0; i < e.count; ++i) {
-      for (size_t j = 0; j < props.size(); ++j) {
-        const PropertySpec& s = props[j];
-        const std::string where = fmt::format("element '{}' item {} property '{}'", e.name, i, s.name);
-        if (scalarOut[j]) {
-          scalarOut[j]->push_back(body.read(s.type, where));
-          continue;
-        }
-        const double c = body.read(s.countType, where);
-        if (c < 0) throw Error(path + ": at " + where + ": negative list length");
-        auto& values = e.listValues[s.name];
-        for (size_t m = 0; m < static_cast<size_t>(c); ++m)
-          values.push_back(static_cast<int64_t>(body.read(s.type, where)));
-        e.listStart[s.name].push_back(values.size());
-      }
+// the items of one element from the body: scalars into e.scalars, lists into e.listValues with their
+// offsets in e.listStart
+void readElement(BodyReader& body, const std::string& path, const std::string& format, PlyElement& e,
+                 const std::vector<PropertySpec>& props) {
+  // a corrupt count must not make us allocate far more than the file holds
+  size_t minBytes = 0;
+  for (const PropertySpec& s : props) minBytes += typeSize(s.countType == PlyType::Invalid ? s.type : s.countType);
+  if (format != "ascii" && minBytes > 0 && e.count > body.remaining() / minBytes)
+    throw Error(fmt::format("{}: element '{}' declares {} items but the file is too short", path, e.name, e.count));
+  std::vector<std::vector<double>*> scalarOut(props.size(), nullptr);
+  for (size_t j = 0; j < props.size(); ++j) {
+    if (props[j].countType == PlyType::Invalid) {
+      scalarOut[j] = &e.scalars[props[j].name];
+      scalarOut[j]->reserve(e.count);
+    } else {
+      e.listStart[props[j].name].push_back(0);
     }
   }
+  for (size_t i = 0; i < e.count; ++i) {
+    for (size_t j = 0; j < props.size(); ++j) {
+      const PropertySpec& s = props[j];
+      const std::string where = fmt::format("element '{}' item {} property '{}'", e.name, i, s.name);
+      if (scalarOut[j]) {
+        scalarOut[j]->push_back(body.read(s.type, where));
+        continue;
+      }
+      const double c = body.read(s.countType, where);
+      if (c < 0) throw Error(path + ": at " + where + ": negative list length");
+      auto& values = e.listValues[s.name];
+      for (size_t m = 0; m < static_cast<size_t>(c); ++m)
+        values.push_back(static_cast<int64_t>(body.read(s.type, where)));
+      e.listStart[s.name].push_back(values.size());
+    }
+  }
+}
+
+}  // namespace
+
+PlyData readPly(const std::string& path) {
+  const std::string data = readTextFile(path);
+  PlyData ply;
+  ply.path = path;
+  std::vector<std::vector<PropertySpec>> specs;
+  const size_t pos = readHeader(data, path, ply, specs);
+  BodyReader body(path, data, pos, ply.format == "ascii", ply.format == "binary_big_endian");
+  for (size_t k = 0; k < ply.elements.size(); ++k) readElement(body, path, ply.format, ply.elements[k], specs[k]);
   return ply;
 }
 
