@@ -64,8 +64,8 @@ struct PreparedMesh {
 // "(a, b)" (fmt: the inlined string concatenation draws a false -Wrestrict warning)
 std::string edgeText(int a, int b) { return fmt::format("({}, {})", a, b); }
 
-PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
-  PreparedMesh m;
+// the mesh in double; throws on a non-finite position or an index out of range
+void copyChecked(const TriangleMesh& mesh, const std::string& source, PreparedMesh& m) {
   const int nv = static_cast<int>(mesh.vertices.size());
   if (mesh.triangles.empty()) throw errorAt(source, "mesh collider", "the mesh has no triangles");
   m.x.resize(nv);
@@ -81,15 +81,21 @@ PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
         throw errorAt(source, "mesh collider, triangle " + std::to_string(t),
                       "vertex index " + std::to_string(m.tri[t][k]) + " is out of range [0, " + std::to_string(nv) +
                           ")");
-  // closed and consistently oriented: every directed edge (a, b) has exactly one twin (b, a)
-  struct Half {
-    int lo, hi, dir, tri, k;
-  };
+}
+
+// a triangle's edge k as (lo, hi) vertices and its direction along them
+struct Half {
+  int lo, hi, dir, tri, k;
+};
+
+// twin[t][k]: the triangle across edge k of triangle t. Throws unless the mesh is closed and
+// consistently oriented: every directed edge (a, b) has exactly one twin (b, a)
+std::vector<std::array<int, 3>> twinTriangles(const std::vector<std::array<int, 3>>& tri, const std::string& source) {
   std::vector<Half> halves;
-  halves.reserve(m.tri.size() * 3);
-  for (int t = 0; t < static_cast<int>(m.tri.size()); ++t)
+  halves.reserve(tri.size() * 3);
+  for (int t = 0; t < static_cast<int>(tri.size()); ++t)
     for (int k = 0; k < 3; ++k) {
-      const int a = m.tri[t][k], b = m.tri[t][(k + 1) % 3];
+      const int a = tri[t][k], b = tri[t][(k + 1) % 3];
       halves.push_back({std::min(a, b), std::max(a, b), a < b ? 0 : 1, t, k});
     }
   std::sort(halves.begin(), halves.end(), [](const Half& p, const Half& q) {
@@ -97,7 +103,7 @@ PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
     if (p.hi != q.hi) return p.hi < q.hi;
     return p.tri < q.tri;
   });
-  std::vector<std::array<int, 3>> twin(m.tri.size(), {-1, -1, -1});
+  std::vector<std::array<int, 3>> twin(tri.size(), {-1, -1, -1});
   for (size_t s = 0; s < halves.size();) {
     size_t e = s;
     while (e < halves.size() && halves[e].lo == halves[s].lo && halves[e].hi == halves[s].hi) ++e;
@@ -115,12 +121,20 @@ PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
     twin[halves[s + 1].tri][halves[s + 1].k] = halves[s].tri;
     s = e;
   }
-  // signed volume (divergence theorem); negative means the normals point inwards
+  return twin;
+}
+
+// flips every triangle when the signed volume (divergence theorem) is negative: the normals pointed
+// inwards
+void orientOutward(PreparedMesh& m) {
   double volume = 0.0;
   for (const auto& t : m.tri) volume += m.x[t[0]].dot(m.x[t[1]].cross(m.x[t[2]])) / 6.0;
   if (volume < 0.0)
     for (auto& t : m.tri) std::swap(t[1], t[2]);
-  // twins are found below by their vertices, so the swap does not disturb them
+}
+
+// unit face normals; throws on a degenerate triangle
+void faceNormals(PreparedMesh& m, const std::string& source) {
   m.faceNormal.resize(m.tri.size());
   for (size_t t = 0; t < m.tri.size(); ++t) {
     const Vec3d n = (m.x[m.tri[t][1]] - m.x[m.tri[t][0]]).cross(m.x[m.tri[t][2]] - m.x[m.tri[t][0]]);
@@ -128,8 +142,13 @@ PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
       throw errorAt(source, "mesh collider, triangle " + std::to_string(t), "degenerate triangle (zero area)");
     m.faceNormal[t] = n.normalized();
   }
+}
+
+// the pseudo-normals of the edges (sum of both faces) and the vertices (angle-weighted sum of the
+// faces around). Twins are found by their vertices, so orientOutward's swap does not disturb them
+void featureNormals(PreparedMesh& m, const std::vector<std::array<int, 3>>& twin) {
   m.edgeNormal.resize(m.tri.size());
-  m.vertexNormal.assign(nv, Vec3d::Zero());
+  m.vertexNormal.assign(m.x.size(), Vec3d::Zero());
   for (size_t t = 0; t < m.tri.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const int a = m.tri[t][k], b = m.tri[t][(k + 1) % 3];
@@ -148,6 +167,15 @@ PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
       m.vertexNormal[a] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * m.faceNormal[t];
     }
   }
+}
+
+PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
+  PreparedMesh m;
+  copyChecked(mesh, source, m);
+  const std::vector<std::array<int, 3>> twin = twinTriangles(m.tri, source);
+  orientOutward(m);
+  faceNormals(m, source);
+  featureNormals(m, twin);
   return m;
 }
 
@@ -170,21 +198,24 @@ void testTriangle(const PreparedMesh& m, int t, const Vec3d& p, Nearest& best) {
   best.sign = (p - q).dot(*n) < 0.0 ? -1.0 : 1.0;
 }
 
-}  // namespace
+// triangles binned by bounding box into buckets of kBucket^3 grid cells, as lists per bucket (CSR)
+constexpr int kBucket = 4;
 
-double exactMeshDistance(const TriangleMesh& mesh, const Vec3d& p) {
-  const PreparedMesh m = prepare(mesh, "mesh");
-  Nearest best;
-  for (int t = 0; t < static_cast<int>(m.tri.size()); ++t) testTriangle(m, t, p, best);
-  return best.sign * std::sqrt(best.dist2);
-}
+struct TriangleBuckets {
+  Vec3d lo;            // m, the grid's node (0, 0, 0)
+  double size = 0.0;   // m, kBucket cells
+  std::array<int, 3> n{0, 0, 0};
+  std::vector<int> start, tris;  // bucket b holds tris[start[b] .. start[b + 1])
 
-SdfGrid buildSdfGrid(const TriangleMesh& mesh, float cellSize, float padding, const std::string& source) {
-  if (!(cellSize > 0.0f) || !std::isfinite(cellSize))
-    throw errorAt(source, "mesh collider", "resolution (cell size) must be a positive length in m");
-  if (!(padding >= 0.0f)) throw errorAt(source, "mesh collider", "padding must be >= 0 m");
-  const PreparedMesh m = prepare(mesh, source);
-  Vec3d lo = m.x[0], hi = m.x[0];
+  int of(double x, int a) const { return std::clamp(static_cast<int>(std::floor((x - lo[a]) / size)), 0, n[a] - 1); }
+  int64_t index(int i, int j, int k) const { return i + int64_t(n[0]) * (j + int64_t(n[1]) * k); }
+};
+
+// the grid over the mesh's bounding box plus padding: origin (lo, m), dims and room for the values;
+// throws when it would have more than kMaxSdfNodes nodes
+SdfGrid layGrid(const PreparedMesh& m, float cellSize, float padding, const std::string& source, Vec3d& lo) {
+  lo = m.x[0];
+  Vec3d hi = m.x[0];
   for (const Vec3d& x : m.x) {
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
@@ -207,61 +238,87 @@ SdfGrid buildSdfGrid(const TriangleMesh& mesh, float cellSize, float padding, co
     throw errorAt(source, "mesh collider",
                   "the grid would have " + std::to_string(nodes) + " nodes (more than 256^3); choose a coarser " +
                       "resolution than " + std::to_string(cellSize) + " m");
+  g.value.resize(nodes);
+  return g;
+}
 
-  // triangles binned by bounding box into buckets of kBucket cells
-  constexpr int kBucket = 4;
-  const double bucketSize = kBucket * h;
-  std::array<int, 3> nb;
-  for (int a = 0; a < 3; ++a) nb[a] = (g.dims[a] - 1) / kBucket + 1;
-  auto bucketOf = [&](double x, int a) {
-    return std::clamp(static_cast<int>(std::floor((x - lo[a]) / bucketSize)), 0, nb[a] - 1);
-  };
-  const int64_t numBuckets = int64_t(nb[0]) * nb[1] * nb[2];
-  std::vector<int> bucketStart(numBuckets + 1, 0), bucketTris;
+// every triangle in each bucket its bounding box touches: counted in a first pass, listed in a second
+TriangleBuckets bucketTriangles(const PreparedMesh& m, const SdfGrid& g, const Vec3d& lo) {
+  TriangleBuckets tb;
+  tb.lo = lo;
+  tb.size = kBucket * static_cast<double>(g.cellSize);
+  for (int a = 0; a < 3; ++a) tb.n[a] = (g.dims[a] - 1) / kBucket + 1;
+  const int64_t numBuckets = int64_t(tb.n[0]) * tb.n[1] * tb.n[2];
+  tb.start.assign(numBuckets + 1, 0);
   for (int pass = 0; pass < 2; ++pass) {
-    std::vector<int> fill(bucketStart.begin(), bucketStart.end() - 1);
+    std::vector<int> fill(tb.start.begin(), tb.start.end() - 1);
     for (int t = 0; t < static_cast<int>(m.tri.size()); ++t) {
       Vec3d tl = m.x[m.tri[t][0]], th = tl;
       for (int k = 1; k < 3; ++k) {
         tl = tl.cwiseMin(m.x[m.tri[t][k]]);
         th = th.cwiseMax(m.x[m.tri[t][k]]);
       }
-      for (int k = bucketOf(tl[2], 2); k <= bucketOf(th[2], 2); ++k)
-        for (int j = bucketOf(tl[1], 1); j <= bucketOf(th[1], 1); ++j)
-          for (int i = bucketOf(tl[0], 0); i <= bucketOf(th[0], 0); ++i) {
-            const int64_t b = i + int64_t(nb[0]) * (j + int64_t(nb[1]) * k);
-            if (pass == 0) ++bucketStart[b + 1];
-            else bucketTris[fill[b]++] = t;
+      for (int k = tb.of(tl[2], 2); k <= tb.of(th[2], 2); ++k)
+        for (int j = tb.of(tl[1], 1); j <= tb.of(th[1], 1); ++j)
+          for (int i = tb.of(tl[0], 0); i <= tb.of(th[0], 0); ++i) {
+            const int64_t b = tb.index(i, j, k);
+            if (pass == 0) ++tb.start[b + 1];
+            else tb.tris[fill[b]++] = t;
           }
     }
     if (pass == 0) {
-      for (int64_t b = 0; b < numBuckets; ++b) bucketStart[b + 1] += bucketStart[b];
-      bucketTris.resize(bucketStart[numBuckets]);
+      for (int64_t b = 0; b < numBuckets; ++b) tb.start[b + 1] += tb.start[b];
+      tb.tris.resize(tb.start[numBuckets]);
     }
   }
+  return tb;
+}
 
-  g.value.resize(nodes);
+// the signed distance from p, in bucket (bi, bj, bk), to the nearest triangle: the buckets ring by
+// ring until the next ring is farther than the nearest triangle found
+double nearestInRings(const PreparedMesh& m, const TriangleBuckets& tb, const Vec3d& p, int bi, int bj, int bk) {
+  const std::array<int, 3>& nb = tb.n;
   const int maxRing = std::max({nb[0], nb[1], nb[2]});
-  parallelFor(nodes, [&](int64_t n) {
+  Nearest best;
+  // ring r holds the buckets at Chebyshev distance r; anything beyond it is >= r bucket sizes away
+  for (int r = 0; r <= maxRing; ++r) {
+    for (int c = std::max(bk - r, 0); c <= std::min(bk + r, nb[2] - 1); ++c)
+      for (int b = std::max(bj - r, 0); b <= std::min(bj + r, nb[1] - 1); ++b)
+        for (int a = std::max(bi - r, 0); a <= std::min(bi + r, nb[0] - 1); ++a) {
+          if (std::max({std::abs(a - bi), std::abs(b - bj), std::abs(c - bk)}) != r) continue;
+          const int64_t bucket = tb.index(a, b, c);
+          for (int s = tb.start[bucket]; s < tb.start[bucket + 1]; ++s) testTriangle(m, tb.tris[s], p, best);
+        }
+    const double reach = r * tb.size;
+    if (best.dist2 <= reach * reach) break;
+  }
+  return best.sign * std::sqrt(best.dist2);
+}
+
+}  // namespace
+
+double exactMeshDistance(const TriangleMesh& mesh, const Vec3d& p) {
+  const PreparedMesh m = prepare(mesh, "mesh");
+  Nearest best;
+  for (int t = 0; t < static_cast<int>(m.tri.size()); ++t) testTriangle(m, t, p, best);
+  return best.sign * std::sqrt(best.dist2);
+}
+
+SdfGrid buildSdfGrid(const TriangleMesh& mesh, float cellSize, float padding, const std::string& source) {
+  if (!(cellSize > 0.0f) || !std::isfinite(cellSize))
+    throw errorAt(source, "mesh collider", "resolution (cell size) must be a positive length in m");
+  if (!(padding >= 0.0f)) throw errorAt(source, "mesh collider", "padding must be >= 0 m");
+  const PreparedMesh m = prepare(mesh, source);
+  Vec3d lo;
+  SdfGrid g = layGrid(m, cellSize, padding, source, lo);
+  const TriangleBuckets buckets = bucketTriangles(m, g, lo);
+  const double h = cellSize;
+  parallelFor(static_cast<int64_t>(g.value.size()), [&](int64_t n) {
     const int i = static_cast<int>(n % g.dims[0]);
     const int j = static_cast<int>((n / g.dims[0]) % g.dims[1]);
     const int k = static_cast<int>(n / (int64_t(g.dims[0]) * g.dims[1]));
     const Vec3d p = lo + h * Vec3d(i, j, k);
-    const int bi = i / kBucket, bj = j / kBucket, bk = k / kBucket;
-    Nearest best;
-    // ring r holds the buckets at Chebyshev distance r; anything beyond it is >= r bucket sizes away
-    for (int r = 0; r <= maxRing; ++r) {
-      for (int c = std::max(bk - r, 0); c <= std::min(bk + r, nb[2] - 1); ++c)
-        for (int b = std::max(bj - r, 0); b <= std::min(bj + r, nb[1] - 1); ++b)
-          for (int a = std::max(bi - r, 0); a <= std::min(bi + r, nb[0] - 1); ++a) {
-            if (std::max({std::abs(a - bi), std::abs(b - bj), std::abs(c - bk)}) != r) continue;
-            const int64_t bucket = a + int64_t(nb[0]) * (b + int64_t(nb[1]) * c);
-            for (int s = bucketStart[bucket]; s < bucketStart[bucket + 1]; ++s) testTriangle(m, bucketTris[s], p, best);
-          }
-      const double reach = r * bucketSize;
-      if (best.dist2 <= reach * reach) break;
-    }
-    g.value[n] = static_cast<float>(best.sign * std::sqrt(best.dist2));
+    g.value[n] = static_cast<float>(nearestInRings(m, buckets, p, i / kBucket, j / kBucket, k / kBucket));
   });
   return g;
 }
