@@ -77,6 +77,117 @@ std::string outputList(const Model& model, const OutputSettings& out) {
   return s + "stats.jsonl";
 }
 
+// run.json: the run's settings, rewritten with its status, the frames written so far, the times, the
+// state's hash and the water's ledger
+struct RunRecord {
+  nlohmann::ordered_json run;
+  std::string path;
+  Clock::time_point wallStart;
+
+  void write(const std::string& status, int framesWritten, const State& state) {
+    run["status"] = status;
+    run["framesWritten"] = framesWritten;
+    run["wallSeconds"] = secondsSince(wallStart);
+    run["steps"] = state.stepCount;
+    run["simulatedSeconds"] = state.time;
+    run["stateHash"] = fmt::format("{:016x}", stateHash(state));
+    run["water"] = waterJson(waterMass(state), state);
+    writeTextFile(path, run.dump(2) + "\n");
+  }
+};
+
+// how the frame loop ended, for the summary
+struct FrameLoopResult {
+  int exitCode = kExitOk;
+  StageTimes ms;            // summed over the run, for the summary's wetting line
+  double simSeconds = 0.0;  // wall time from the first step to the last frame written
+};
+
+// frames 0 (the initial state) to `frames`, each written with its line of stats.jsonl; stops at the
+// first diverged frame (written too, marked "error"). run.json follows the status
+FrameLoopResult simulateFrames(Scene& scene, const RunOptions& o, const fs::path& dir, int frames, RunRecord& record) {
+  const Model& model = scene.model;
+  State& state = scene.state;
+  const OutputSettings& out = scene.output;
+  const int stepsPerFrame = std::max(1, out.stepsPerFrame);
+  const float dt = model.solver.dt;
+  JsonLinesWriter stats((dir / "stats.jsonl").string());
+  WorkspacePtr ws = makeWorkspace();
+  Progress progress(frames, !o.quiet);
+  const Clock::time_point simStart = Clock::now();
+  int written = 0;
+  FrameLoopResult result;
+  try {
+    for (int frame = 0; frame <= frames; ++frame) {
+      FrameStats fs;
+      for (int s = 0; frame > 0 && s < stepsPerFrame; ++s) {
+        StepStats st;
+        step(model, state, *ws, dt, st);
+        fs.add(st);
+      }
+      result.ms += fs.ms;
+      const std::string bad = checkState(model, state);
+      writeFrame(dir.string(), model, state, out, frame);  // a diverged frame too: it shows where the blow-up started
+      nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
+      if (!bad.empty()) line["error"] = bad;
+      stats.write(line);
+      ++written;
+      if (!bad.empty()) {
+        progress.finish();
+        record.write("diverged", written, state);
+        std::fprintf(stderr,
+                     "soak: simulation diverged at frame %d (t = %.4f s, step %llu): %s\n"
+                     "soak: frame %d was written to %s and marked \"error\" in stats.jsonl; the last good frame is "
+                     "%d\n",
+                     frame, state.time, static_cast<unsigned long long>(state.stepCount), bad.c_str(), frame,
+                     o.outDir.c_str(), frame - 1);
+        result.exitCode = kExitDiverged;
+        return result;
+      }
+      if (frame > 0) progress.update(frame, state.time, fs.ms.total / std::max(1, fs.steps));
+    }
+  } catch (const Error&) {
+    progress.finish();
+    record.write("error", written, state);
+    throw;
+  }
+  progress.finish();
+  record.write("ok", written, state);
+  result.simSeconds = secondsSince(simStart);
+  return result;
+}
+
+// the summary on stdout: what was written, the steps' time (the wetting's stages apart, as Table 2 of
+// Shao 2017) and where the emitted water went
+void printRunSummary(const Scene& scene, const RunOptions& o, int frames, const FrameLoopResult& r) {
+  const Model& model = scene.model;
+  const State& state = scene.state;
+  const float dt = model.solver.dt;
+  const WaterMass w = waterMass(state);
+  std::printf("soak: wrote frames 0..%d of %s to %s (%s, scene.json, run.json)\n", frames, scene.name.c_str(),
+              o.outDir.c_str(), outputList(model, scene.output).c_str());
+  std::printf("soak: %llu steps of %g s in %s (%.2f ms/step) on %d threads\n",
+              static_cast<unsigned long long>(state.stepCount), static_cast<double>(dt),
+              Progress::formatDuration(r.simSeconds).c_str(),
+              state.stepCount > 0 ? 1e3 * r.simSeconds / static_cast<double>(state.stepCount) : 0.0, threadCount());
+  if (model.wetting.enabled && state.stepCount > 0) {
+    // Table 2 of Shao 2017 gives the wetting's time apart from the step's: the same split, stage by stage
+    const double steps = static_cast<double>(state.stepCount);
+    std::string parts;
+    for (int k = static_cast<int>(StagePart::wettingPorosity); k <= static_cast<int>(StagePart::wettingFinish); ++k) {
+      const std::string name = kStagePartNames[k];  // "wetting.porosity": the stage's name after the dot
+      parts += fmt::format("{}{} {:.2f}", parts.empty() ? "" : ", ", name.substr(name.find('.') + 1), r.ms.parts[k] / steps);
+    }
+    std::printf("soak: solver %.2f ms a step (frames not written), of which wetting %.2f (%s)\n", r.ms.total / steps,
+                r.ms.wetting / steps, parts.c_str());
+  }
+  std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
+              "removed at bounds %.6g kg (%llu particles) + taken in by garments %.6g kg; unaccounted %.3g kg\n",
+              w.emitted, w.free, w.heldInCloth, w.inBuffers, w.removedAtBounds,
+              static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.takenByCloth,
+              w.emitted - w.total);
+}
+
 }  // namespace
 
 std::string joinCommandLine(const std::vector<std::string>& args) {
@@ -103,12 +214,9 @@ int runCommand(const RunOptions& o) {
   Scene scene = loadScene(o.scene, o.overrides);
   if (o.threads > 0) setThreadCount(o.threads);
   if (!o.quiet) std::fputs(busyMachineHint(threadCount()).c_str(), stderr);
-  const Model& model = scene.model;
-  State& state = scene.state;
-  const OutputSettings& out = scene.output;
-  const int frames = o.frames >= 0 ? o.frames : out.frames;
-  const int stepsPerFrame = std::max(1, out.stepsPerFrame);
-  const float dt = model.solver.dt;
+  const int frames = o.frames >= 0 ? o.frames : scene.output.frames;
+  const int stepsPerFrame = std::max(1, scene.output.stepsPerFrame);
+  const float dt = scene.model.solver.dt;
 
   prepareOutputDir(o.outDir, o.overwrite);
   const fs::path dir(o.outDir);
@@ -123,87 +231,12 @@ int runCommand(const RunOptions& o) {
                         {"dt", std::stod(fmt::format("{}", dt))},
                         {"startTime", startTime},
                         {"status", "running"}};
-  const std::string runPath = (dir / "run.json").string();
-  const auto writeRun = [&](const std::string& status, int framesWritten) {
-    run["status"] = status;
-    run["framesWritten"] = framesWritten;
-    run["wallSeconds"] = secondsSince(wallStart);
-    run["steps"] = state.stepCount;
-    run["simulatedSeconds"] = state.time;
-    run["stateHash"] = fmt::format("{:016x}", stateHash(state));
-    run["water"] = waterJson(waterMass(state), state);
-    writeTextFile(runPath, run.dump(2) + "\n");
-  };
-  writeRun("running", 0);
+  RunRecord record{std::move(run), (dir / "run.json").string(), wallStart};
+  record.write("running", 0, scene.state);
 
-  JsonLinesWriter stats((dir / "stats.jsonl").string());
-  WorkspacePtr ws = makeWorkspace();
-  Progress progress(frames, !o.quiet);
-  const Clock::time_point simStart = Clock::now();
-  int written = 0;
-  StageTimes runMs;  // summed over the run, for the summary's wetting line
-  try {
-    for (int frame = 0; frame <= frames; ++frame) {
-      FrameStats fs;
-      for (int s = 0; frame > 0 && s < stepsPerFrame; ++s) {
-        StepStats st;
-        step(model, state, *ws, dt, st);
-        fs.add(st);
-      }
-      runMs += fs.ms;
-      const std::string bad = checkState(model, state);
-      writeFrame(dir.string(), model, state, out, frame);  // a diverged frame too: it shows where the blow-up started
-      nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
-      if (!bad.empty()) line["error"] = bad;
-      stats.write(line);
-      ++written;
-      if (!bad.empty()) {
-        progress.finish();
-        writeRun("diverged", written);
-        std::fprintf(stderr,
-                     "soak: simulation diverged at frame %d (t = %.4f s, step %llu): %s\n"
-                     "soak: frame %d was written to %s and marked \"error\" in stats.jsonl; the last good frame is "
-                     "%d\n",
-                     frame, state.time, static_cast<unsigned long long>(state.stepCount), bad.c_str(), frame,
-                     o.outDir.c_str(), frame - 1);
-        return kExitDiverged;
-      }
-      if (frame > 0) progress.update(frame, state.time, fs.ms.total / std::max(1, fs.steps));
-    }
-  } catch (const Error&) {
-    progress.finish();
-    writeRun("error", written);
-    throw;
-  }
-  progress.finish();
-  writeRun("ok", written);
-
-  if (!o.quiet) {
-    const double simSeconds = secondsSince(simStart);
-    const WaterMass w = waterMass(state);
-    std::printf("soak: wrote frames 0..%d of %s to %s (%s, scene.json, run.json)\n", frames, scene.name.c_str(),
-                o.outDir.c_str(), outputList(model, out).c_str());
-    std::printf("soak: %llu steps of %g s in %s (%.2f ms/step) on %d threads\n",
-                static_cast<unsigned long long>(state.stepCount), static_cast<double>(dt),
-                Progress::formatDuration(simSeconds).c_str(),
-                state.stepCount > 0 ? 1e3 * simSeconds / static_cast<double>(state.stepCount) : 0.0, threadCount());
-    if (model.wetting.enabled && state.stepCount > 0) {
-      // Table 2 of Shao 2017 gives the wetting's time apart from the step's: the same split, stage by stage
-      const double steps = static_cast<double>(state.stepCount);
-      std::string parts;
-      for (int k = static_cast<int>(StagePart::wettingPorosity); k <= static_cast<int>(StagePart::wettingFinish); ++k) {
-        const std::string name = kStagePartNames[k];  // "wetting.porosity": the stage's name after the dot
-        parts += fmt::format("{}{} {:.2f}", parts.empty() ? "" : ", ", name.substr(name.find('.') + 1), runMs.parts[k] / steps);
-      }
-      std::printf("soak: solver %.2f ms a step (frames not written), of which wetting %.2f (%s)\n", runMs.total / steps,
-                  runMs.wetting / steps, parts.c_str());
-    }
-    std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
-                "removed at bounds %.6g kg (%llu particles) + taken in by garments %.6g kg; unaccounted %.3g kg\n",
-                w.emitted, w.free, w.heldInCloth, w.inBuffers, w.removedAtBounds,
-                static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.takenByCloth,
-                w.emitted - w.total);
-  }
+  const FrameLoopResult result = simulateFrames(scene, o, dir, frames, record);
+  if (result.exitCode != kExitOk) return result.exitCode;
+  if (!o.quiet) printRunSummary(scene, o, frames, result);
   return kExitOk;
 }
 
