@@ -136,18 +136,10 @@ uint64_t peakRssBytes() {
   return static_cast<uint64_t>(u.ru_maxrss) * 1024u;
 }
 
-json runOne(const BenchJob& job, int threads, bool quiet) {
-  Scene scene = loadScene(job.scene, job.overrides);
-  if (threads > 0) setThreadCount(threads);
-  if (!quiet) std::fputs(busyMachineHint(threadCount()).c_str(), stderr);
-  const Model& model = scene.model;
-  State& state = scene.state;
+// the job's warm-up steps, then its timed steps with their stats; throws when either diverges
+std::vector<StepStats> timeSteps(const BenchJob& job, const Model& model, State& state, int steps, bool quiet) {
   const float dt = model.solver.dt;
   WorkspacePtr ws = makeWorkspace();
-  const int steps = job.wholeRun ? scene.output.frames * scene.output.stepsPerFrame : job.steps;
-  if (steps < 1)
-    throw Error(job.scene + ": --whole-run needs at least one step (output.frames x output.stepsPerFrame is " +
-                std::to_string(steps) + ")");
   if (!quiet) std::fprintf(stderr, "soak bench: %s: %d warm-up steps, %d timed steps%s\n", job.name.c_str(), job.warmup,
                            steps, job.wholeRun ? " (the whole run)" : "");
   for (int s = 0; s < job.warmup; ++s) {
@@ -166,10 +158,17 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   progress.finish();
   bad = checkState(model, state);
   if (!bad.empty()) throw Error(job.scene + ": diverged while timed: " + bad);
+  return timed;
+}
 
-  size_t water = 0;
-  for (int32_t ph : state.particles.phase) water += isWater(ph) ? 1 : 0;
-  const size_t particles = state.particles.size();
+// the median and mean over the timed steps of every stage (ms, msMean) and every stage part (parts,
+// partsMean), by name
+struct StageSummary {
+  json ms = json::object(), msMean = json::object();
+  json parts = json::object(), partsMean = json::object();  // StagePart, as the stages
+};
+
+StageSummary summarizeStages(const std::vector<StepStats>& timed) {
   // the median and mean over the timed steps of one time, under name in med and mean
   const auto summarize = [&](json& med, json& mean, const char* name, auto&& time) {
     std::vector<double> v;
@@ -178,9 +177,9 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
     med[name] = median(v);
     mean[name] = sum / static_cast<double>(v.size());
   };
-  json ms = json::object(), msMean = json::object();
+  StageSummary out;
   const auto stage = [&](const char* name, double StageTimes::*field) {
-    summarize(ms, msMean, name, [&](const StageTimes& t) { return t.*field; });
+    summarize(out.ms, out.msMean, name, [&](const StageTimes& t) { return t.*field; });
   };
   stage("emit", &StageTimes::emit);
   stage("predict", &StageTimes::predict);
@@ -193,14 +192,43 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
   stage("wetting", &StageTimes::wetting);
   stage("garment", &StageTimes::garment);
   stage("total", &StageTimes::total);
-  json parts = json::object(), partsMean = json::object();  // StagePart, as the stages
   for (int k = 0; k < kStagePartCount; ++k)
-    summarize(parts, partsMean, kStagePartNames[k], [&](const StageTimes& t) { return t.parts[k]; });
+    summarize(out.parts, out.partsMean, kStagePartNames[k], [&](const StageTimes& t) { return t.parts[k]; });
+  return out;
+}
+
+// whether the job met its targets: a window of steps compares its median (robust to a slow step); a
+// whole run its mean, as Table 2 of Shao 2017 gives "the average time cost of each simulation step"
+void checkTargets(const BenchJob& job, double medianTotal, double meanTotal, json& r) {
+  if (job.targets.contains("targetMsPerStep")) {
+    r["targets"]["msPerStepBasis"] = job.wholeRun ? "mean" : "median";
+    r["targets"]["msPerStepMet"] = (job.wholeRun ? meanTotal : medianTotal) <= job.targets["targetMsPerStep"].get<double>();
+  }
+  if (job.targets.contains("targetBytesPerParticle"))
+    r["targets"]["bytesPerParticleMet"] = r["bytesPerParticle"].get<double>() <= job.targets["targetBytesPerParticle"].get<double>();
+}
+
+json runOne(const BenchJob& job, int threads, bool quiet) {
+  Scene scene = loadScene(job.scene, job.overrides);
+  if (threads > 0) setThreadCount(threads);
+  if (!quiet) std::fputs(busyMachineHint(threadCount()).c_str(), stderr);
+  const Model& model = scene.model;
+  State& state = scene.state;
+  const int steps = job.wholeRun ? scene.output.frames * scene.output.stepsPerFrame : job.steps;
+  if (steps < 1)
+    throw Error(job.scene + ": --whole-run needs at least one step (output.frames x output.stepsPerFrame is " +
+                std::to_string(steps) + ")");
+  const std::vector<StepStats> timed = timeSteps(job, model, state, steps, quiet);
+
+  size_t water = 0;
+  for (int32_t ph : state.particles.phase) water += isWater(ph) ? 1 : 0;
+  const size_t particles = state.particles.size();
+  const StageSummary st = summarizeStages(timed);
   uint64_t contacts = 0;
-  for (const StepStats& st : timed) contacts += st.couplingContacts;
-  const double meanTotal = msMean["total"].get<double>();
+  for (const StepStats& t : timed) contacts += t.couplingContacts;
+  const double meanTotal = st.msMean["total"].get<double>();
   const uint64_t peak = peakRssBytes();
-  const double medianTotal = ms["total"].get<double>();
+  const double medianTotal = st.ms["total"].get<double>();
   json r = {{"name", job.name},
             {"scene", job.scene},
             {"overrides", job.overrides},
@@ -208,18 +236,18 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
             {"warmup", job.warmup},
             {"steps", steps},
             {"wholeRun", job.wholeRun},
-            {"dt", decimal(dt)},
+            {"dt", decimal(model.solver.dt)},
             {"particles", {{"water", water}, {"cloth", model.numCloth}, {"total", particles}}},
             {"iterations",
              {{"fluid", model.solver.fluidIterations},
               {"cloth", model.solver.clothIterations},
               {"coupling", model.solver.couplingIterations},
               {"substeps", model.solver.substeps}}},
-            {"msPerStepMedian", ms},
+            {"msPerStepMedian", st.ms},
             {"msPerStepMean", meanTotal},
-            {"msPerStepMeanStages", msMean},
-            {"msPerStepMedianParts", parts},
-            {"msPerStepMeanParts", partsMean},
+            {"msPerStepMeanStages", st.msMean},
+            {"msPerStepMedianParts", st.parts},
+            {"msPerStepMeanParts", st.partsMean},
             {"nsPerParticleStep", particles > 0 ? medianTotal * 1e6 / static_cast<double>(particles) : 0.0},
             {"couplingContactsPerStep", timed.empty() ? 0.0 : static_cast<double>(contacts) / timed.size()},
             {"peakRssBytes", peak},
@@ -227,14 +255,7 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
             {"simulatedSeconds", state.time},
             {"stateHash", fmt::format("{:016x}", stateHash(state))},
             {"targets", job.targets}};
-  // a window of steps compares its median (robust to a slow step); a whole run its mean, as Table 2
-  // of Shao 2017 gives "the average time cost of each simulation step"
-  if (job.targets.contains("targetMsPerStep")) {
-    r["targets"]["msPerStepBasis"] = job.wholeRun ? "mean" : "median";
-    r["targets"]["msPerStepMet"] = (job.wholeRun ? meanTotal : medianTotal) <= job.targets["targetMsPerStep"].get<double>();
-  }
-  if (job.targets.contains("targetBytesPerParticle"))
-    r["targets"]["bytesPerParticleMet"] = r["bytesPerParticle"].get<double>() <= job.targets["targetBytesPerParticle"].get<double>();
+  checkTargets(job, medianTotal, meanTotal, r);
   return r;
 }
 
