@@ -1,0 +1,214 @@
+// a "cloth" entry of the scene file: mesh, material, pins and the Chen 2012 keys (cloth_keys.hpp)
+#include "scene/cloth_keys.hpp"
+
+#include <soak/error.hpp>
+
+#include "scene/common.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace soak {
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
+  const ClothMaterial d;
+  ClothMaterial m;
+  if (solver == ClothSolver::Implicit) {  // the KES laws, Rayleigh damping and wet friction replace these
+    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction", "tetherSlack"})
+      if (r.has(key))
+        r.log().error(r.pathOf(key), fmt::format("expected no {} on a piece with \"solver\": \"implicit\" (a PBD "
+                                                 "key; set the garment section instead, docs/scene-format.md)",
+                                                 key));
+    if (const Json* sc = r.get("selfCollision"); sc && sc->is_boolean() && sc->get<bool>())
+      r.log().error(r.pathOf("selfCollision"),
+                    "expected false on a piece with \"solver\": \"implicit\" (the implicit solver has no "
+                    "self-collision), got true");
+  }
+  m.particleMass = r.number("particleMass", d.particleMass, Range::positive());
+  m.restDensity = r.number("restDensity", d.restDensity, Range::positive());
+  m.stretchCompliance = r.number("stretchCompliance", d.stretchCompliance, Range::nonNegative());
+  m.bendCompliance = r.number("bendCompliance", d.bendCompliance, Range::nonNegative());
+  m.damping = r.number("damping", d.damping, Range::nonNegative());
+  m.thickness = r.number("thickness", d.thickness, Range::positive());
+  m.friction = r.number("friction", d.friction, Range::unit());
+  m.selfCollision = r.boolean("selfCollision", d.selfCollision) && solver == ClothSolver::Pbd;
+  m.tetherSlack = r.number("tetherSlack", d.tetherSlack, Range::nonNegative());
+  r.finish();
+  return m;
+}
+
+// the corners of a rectangle, in the order of docs/scene-format.md: 0 = (-u,-v), 1 = (+u,-v),
+// 2 = (-u,+v), 3 = (+u,+v)
+struct RectangleInfo {
+  Vec3 corner[4];
+};
+
+int nearestVertex(const TriangleMesh& mesh, const Vec3& p) {
+  int best = 0;
+  for (int i = 1; i < int(mesh.vertices.size()); ++i)
+    if ((mesh.vertices[i] - p).squaredNorm() < (mesh.vertices[best] - p).squaredNorm()) best = i;
+  return best;
+}
+
+const std::vector<std::string> kRectangleKeys = {"center", "size", "resolution", "axisU", "axisV"};
+const std::vector<std::string> kObjKeys = {"path", "scale", "translate", "rotate"};
+
+// reads "mesh" and builds the triangle mesh; nullopt when it is invalid (errors logged)
+std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir, int maxVertices,
+                                     std::optional<RectangleInfo>& rect, const Bodies& bodies,
+                                     std::vector<int>& panelOfVertex) {
+  ErrorLog& log = m.log();
+  const size_t errorsBefore = log.messages().size();
+  const int type = m.choice("type", {"rectangle", "obj", "garment"}, std::nullopt);
+  if (type == 2) {
+    std::optional<TriangleMesh> mesh = readGarmentMesh(m, bodies, panelOfVertex);
+    m.finish(concat(kRectangleKeys, kObjKeys), "a garment mesh");
+    if (mesh && int64_t(mesh->vertices.size()) > maxVertices) {
+      log.error(m.path(), fmt::format("expected at most solver.maxParticles ({}) vertices, got {}", maxVertices,
+                                      mesh->vertices.size()));
+      return std::nullopt;
+    }
+    return mesh;
+  }
+  if (type == 0) {
+    const Vec3 center = m.vec3("center", Vec3::Zero());
+    const std::vector<float> size = m.numbers("size", 2, std::nullopt, Range::positive());
+    const std::vector<int> res = m.integers("resolution", 2, std::nullopt, Range::atLeast(2));
+    const Vec3 u = m.unitVec3("axisU", Vec3::UnitX());
+    const Vec3 v = m.unitVec3("axisV", Vec3::UnitZ());
+    m.finish(concat(kObjKeys, kGarmentMeshKeys), "a rectangle mesh");
+    if (std::abs(u.dot(v)) > 1e-3f)
+      log.error(m.pathOf("axisV"), fmt::format("expected a direction perpendicular to axisU {}, got {}", fmtVec(u),
+                                               fmtVec(v)));
+    if (log.messages().size() != errorsBefore) return std::nullopt;
+    if (int64_t(res[0]) * res[1] > maxVertices) {
+      log.error(m.pathOf("resolution"), fmt::format("expected at most solver.maxParticles ({}) vertices, got {} x {}",
+                                                    maxVertices, res[0], res[1]));
+      return std::nullopt;
+    }
+    RectangleInfo info;
+    for (int c = 0; c < 4; ++c)
+      info.corner[c] = center + ((c & 1) ? 0.5f : -0.5f) * size[0] * u + ((c & 2) ? 0.5f : -0.5f) * size[1] * v;
+    rect = info;
+    return makeRectangle(center, u, v, size[0], size[1], res[0], res[1]);
+  }
+  if (type == 1) {
+    const std::string file = m.string("path", std::nullopt);
+    const float scale = m.number("scale", 1.0f, Range::positive());
+    const Vec3 translate = m.vec3("translate", Vec3::Zero());
+    const Quat rotate = readRotation(m.object("rotate"));
+    m.finish(concat(kRectangleKeys, kGarmentMeshKeys), "an obj mesh");
+    if (log.messages().size() != errorsBefore) return std::nullopt;
+    const fs::path resolved(resolvePath(file, baseDir));
+    std::error_code ec;
+    if (!fs::is_regular_file(resolved, ec)) {
+      log.error(m.pathOf("path"), fmt::format("expected the path of an existing OBJ file, got \"{}\" (tried \"{}\")",
+                                              file, resolved.string()));
+      return std::nullopt;
+    }
+    try {
+      TriangleMesh mesh = loadObjMesh(resolved.string());
+      // scale, then rotate, then translate
+      for (Vec3& x : mesh.vertices) x = rotate * (scale * x) + translate;
+      if (int64_t(mesh.vertices.size()) > maxVertices) {
+        log.error(m.pathOf("path"), fmt::format("expected at most solver.maxParticles ({}) vertices, got {}",
+                                                maxVertices, mesh.vertices.size()));
+        return std::nullopt;
+      }
+      return mesh;
+    } catch (const Error& e) {
+      log.error(m.pathOf("path"), e.what());
+      return std::nullopt;
+    }
+  }
+  return std::nullopt;
+}
+
+// "pin": vertices, corners (rectangles), region; returns sorted unique mesh vertex indices
+std::vector<int> readPins(ObjectReader p, const TriangleMesh* mesh, const std::optional<RectangleInfo>& rect) {
+  ErrorLog& log = p.log();
+  std::vector<int> pinned;
+  const int nv = mesh ? int(mesh->vertices.size()) : 0;
+  if (const Json* vs = p.array("vertices")) {
+    const Range range = mesh ? Range::between(0, nv - 1) : Range::atLeast(0);
+    for (size_t i = 0; i < vs->size(); ++i)
+      if (const auto d = readNumber(log, (*vs)[i], indexPath(p.pathOf("vertices"), i), range, true))
+        pinned.push_back(int(*d));
+  }
+  if (const Json* cs = p.array("corners")) {
+    if (mesh && !rect) {
+      log.error(p.pathOf("corners"), "expected no corners on an obj mesh (corners are for rectangle meshes; use "
+                                     "vertices or region), got " + describeJson(*cs));
+    } else {
+      for (size_t i = 0; i < cs->size(); ++i)
+        if (const auto d = readNumber(log, (*cs)[i], indexPath(p.pathOf("corners"), i), Range::between(0, 3), true))
+          if (mesh) pinned.push_back(nearestVertex(*mesh, rect->corner[int(*d)]));
+    }
+  }
+  ObjectReader region = p.object("region");
+  if (region.present()) {
+    const Vec3 lo = region.vec3("min", std::nullopt);
+    const Vec3 hi = region.vec3("max", std::nullopt);
+    region.finish();
+    const bool ordered = checkOrdered(log, region.pathOf("max"), "region.min", lo, hi);
+    if (mesh && ordered) {
+      size_t inside = 0;
+      for (int i = 0; i < nv; ++i) {
+        const Vec3& x = mesh->vertices[i];
+        if ((x.array() >= lo.array()).all() && (x.array() <= hi.array()).all()) {
+          pinned.push_back(i);
+          ++inside;
+        }
+      }
+      if (inside == 0)
+        log.error(region.path(), fmt::format("expected a box containing at least one vertex of the mesh, got min "
+                                             "{} max {} (no vertex inside)", fmtVec(lo), fmtVec(hi)));
+    }
+  }
+  p.finish();
+  std::sort(pinned.begin(), pinned.end());
+  pinned.erase(std::unique(pinned.begin(), pinned.end()), pinned.end());
+  return pinned;
+}
+
+}  // namespace
+
+std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::string& path, int index,
+                                   const std::string& baseDir, int maxVertices, bool shaoWetting, const Bodies& bodies,
+                                   const std::vector<Collider>& colliders) {
+  if (!v.is_object()) {
+    log.expected(path, "an object (a cloth piece)", v);
+    return std::nullopt;
+  }
+  ObjectReader r(log, &v, path);
+  ClothSpec spec;
+  spec.path = path;
+  spec.name = r.string("name", fmt::format("cloth{}", index));
+  const ClothSolver solver = readClothSolver(r);
+  std::optional<RectangleInfo> rect;
+  std::optional<TriangleMesh> mesh =
+      readMesh(r.object("mesh", true), baseDir, maxVertices, rect, bodies, spec.panelOfVertex);
+  spec.material = readMaterial(r.object("material"), solver);
+  spec.pinned = readPins(r.object("pin"), mesh ? &*mesh : nullptr, rect);
+  spec.chen = readChenCloth(r, solver, shaoWetting);
+  r.finish();
+  if (!mesh) return std::nullopt;
+  if (spec.chen.bodyMargin < 0.0f) spec.chen.bodyMargin = 0.5f * spec.material.thickness;
+  checkOutsideBody(log, path, spec.chen, bodies, colliders, *mesh);
+  spec.mesh = std::move(*mesh);
+  return spec;
+}
+
+}  // namespace soak

@@ -1,0 +1,37 @@
+// a "cloth" entry of the scene file (docs/scene-format.md): its mesh (rectangle, OBJ file or garment),
+// material, pinned vertices and Chen 2012 settings, read and checked into a ClothSpec
+#pragma once
+#include <soak/model.hpp>
+
+#include "scene/chen_keys.hpp"
+#include "scene/reader.hpp"
+#include "world/mesh.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace soak {
+
+// a validated cloth piece waiting to be appended to the model
+struct ClothSpec {
+  std::string name;
+  std::string path;  // JSON path of the piece, for build-time errors
+  TriangleMesh mesh;
+  ClothMaterial material;
+  std::vector<int> pinned;  // mesh vertex indices, sorted, unique
+  ChenClothSpec chen;       // solver, saturation mass, garment settings (Chen 2012)
+  std::vector<int> panelOfVertex;
+};
+
+// reads cloth[index] (v, at JSON path `path`); nullopt when it is invalid (errors logged). Meshes
+// have at most maxVertices vertices; a garment is sewn around a mannequin of `bodies`, and a piece
+// with a "body" is checked against (or pushed out of) the colliders
+std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::string& path, int index,
+                                   const std::string& baseDir, int maxVertices, bool shaoWetting, const Bodies& bodies,
+                                   const std::vector<Collider>& colliders);
+
+// a's keys then b's: the keys of the other types, which ObjectReader::finish names as misplaced
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
+
+}  // namespace soak
