@@ -357,6 +357,63 @@ std::vector<T> readArray(ObjectReader& top, const std::string& key, F&& readOne)
   return out;
 }
 
+// the scene needs something to simulate, and its cloth fits in solver.maxParticles
+void checkSceneSize(ErrorLog& log, ObjectReader& top, const std::vector<ClothSpec>& cloth, int maxVertices) {
+  const Json* clothJson = top.get("cloth");
+  const Json* emitterJson = top.get("emitters");
+  const bool noCloth = !clothJson || !clothJson->is_array() || clothJson->empty();
+  const bool noEmitter = !emitterJson || !emitterJson->is_array() || emitterJson->empty();
+  if (noCloth && noEmitter) log.error("", "expected at least one cloth piece or emitter, got none (empty scene)");
+  size_t clothParticles = 0;
+  for (const ClothSpec& c : cloth) clothParticles += c.mesh.vertices.size();
+  if (clothParticles > size_t(maxVertices))
+    log.error("cloth", fmt::format("expected at most solver.maxParticles ({}) cloth particles in all, got {}",
+                                   maxVertices, clothParticles));
+}
+
+// appends the validated pieces with their Chen 2012 settings, then the tethers and the springs of the
+// implicit pieces; topology is checked by addClothPiece (manifold edges, degenerate triangles)
+void buildCloth(Model& model, const std::vector<ClothSpec>& cloth, const std::string& file) {
+  for (const ClothSpec& c : cloth) {
+    addClothPiece(model, c.name, c.mesh, c.material, c.pinned, fmt::format("{}: at {}.mesh", file, c.path),
+                  c.chen.solver);
+    ClothPiece& piece = model.pieces.back();
+    piece.garment = c.chen.garment;
+    piece.wetByContact = c.chen.wetByContact;
+    piece.dropsVanish = c.chen.dropsVanish;
+    piece.panelOfVertex = c.panelOfVertex;
+  }
+  buildTethers(model);
+  buildGarmentPieces(model);  // Chen 2012 springs of the implicit pieces
+}
+
+// the initial state: the cloth particles at rest (pinned ones immovable), the emitters' states, the
+// wet-by-contact start times (0 for a piece wet from the start) and the wetting state
+void initState(ErrorLog& log, const Model& model, const std::vector<ClothSpec>& cloth, State& state) {
+  Particles& p = state.particles;
+  for (size_t k = 0; k < model.pieces.size(); ++k) {
+    const ClothPiece& piece = model.pieces[k];
+    for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
+      p.add(int32_t(k + 1), uint32_t(i), model.clothDryMass[size_t(i)], model.water.supportRadius,
+            model.clothRestPosition[size_t(i)], Vec3::Zero());
+      if (model.clothPinned[size_t(i)]) p.invMass.back() = 0.0f;
+    }
+  }
+  state.nextId = uint32_t(model.numCloth);
+  state.emitters.resize(model.emitters.size());
+  for (const ClothPiece& piece : model.pieces)
+    if (piece.wetByContact) state.clothWetStart.assign(size_t(model.numCloth), std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < cloth.size(); ++k)
+    if (cloth[k].chen.wetAtStart && model.pieces[k].wetByContact)
+      std::fill_n(state.clothWetStart.begin() + model.pieces[k].firstParticle, model.pieces[k].particleCount, 0.0f);
+  if (model.wetting.enabled) {
+    const std::vector<float> volume = restVolumes(model, p.radius);
+    checkDripThreshold(log, model, volume);
+    log.throwIfAny();
+    initWettingState(model, volume, state);
+  }
+}
+
 Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
                  const std::vector<std::string>& overrides) {
   applyOverrides(doc, overrides, file);
@@ -389,52 +446,11 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
     return readEmitter(log, v, p, i, model.solver);
   });
   top.finish();
-  const Json* clothJson = top.get("cloth");
-  const Json* emitterJson = top.get("emitters");
-  const bool noCloth = !clothJson || !clothJson->is_array() || clothJson->empty();
-  const bool noEmitter = !emitterJson || !emitterJson->is_array() || emitterJson->empty();
-  if (noCloth && noEmitter) log.error("", "expected at least one cloth piece or emitter, got none (empty scene)");
-  size_t clothParticles = 0;
-  for (const ClothSpec& c : cloth) clothParticles += c.mesh.vertices.size();
-  if (clothParticles > size_t(maxVertices))
-    log.error("cloth", fmt::format("expected at most solver.maxParticles ({}) cloth particles in all, got {}",
-                                   maxVertices, clothParticles));
+  checkSceneSize(log, top, cloth, maxVertices);
   log.throwIfAny();
 
-  // build: topology is checked by addClothPiece (manifold edges, degenerate triangles)
-  for (const ClothSpec& c : cloth) {
-    addClothPiece(model, c.name, c.mesh, c.material, c.pinned, fmt::format("{}: at {}.mesh", file, c.path),
-                  c.chen.solver);
-    ClothPiece& piece = model.pieces.back();
-    piece.garment = c.chen.garment;
-    piece.wetByContact = c.chen.wetByContact;
-    piece.dropsVanish = c.chen.dropsVanish;
-    piece.panelOfVertex = c.panelOfVertex;
-  }
-  buildTethers(model);
-  buildGarmentPieces(model);  // Chen 2012 springs of the implicit pieces
-  Particles& p = scene.state.particles;
-  for (size_t k = 0; k < model.pieces.size(); ++k) {
-    const ClothPiece& piece = model.pieces[k];
-    for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
-      p.add(int32_t(k + 1), uint32_t(i), model.clothDryMass[size_t(i)], model.water.supportRadius,
-            model.clothRestPosition[size_t(i)], Vec3::Zero());
-      if (model.clothPinned[size_t(i)]) p.invMass.back() = 0.0f;
-    }
-  }
-  scene.state.nextId = uint32_t(model.numCloth);
-  scene.state.emitters.resize(model.emitters.size());
-  for (const ClothPiece& piece : model.pieces)
-    if (piece.wetByContact) scene.state.clothWetStart.assign(size_t(model.numCloth), std::numeric_limits<float>::infinity());
-  for (size_t k = 0; k < cloth.size(); ++k)
-    if (cloth[k].chen.wetAtStart && model.pieces[k].wetByContact)
-      std::fill_n(scene.state.clothWetStart.begin() + model.pieces[k].firstParticle, model.pieces[k].particleCount, 0.0f);
-  if (model.wetting.enabled) {
-    const std::vector<float> volume = restVolumes(model, p.radius);
-    checkDripThreshold(log, model, volume);
-    log.throwIfAny();
-    initWettingState(model, volume, scene.state);
-  }
+  buildCloth(model, cloth, file);
+  initState(log, model, cloth, scene.state);
   return scene;
 }
 
