@@ -70,7 +70,7 @@ void constraintSteps(const Model& model, const State& state, const NeighborLists
     float* const W = s.pairFloat.get(count);
     const float rho0 = restDensity(model, p, i), kdL = kd, etaL = eta;  // locals: the compiler does not
 #pragma omp simd                                                         // vectorise loads through the closure
-    for (uint32_t k = 0; k < count; ++k) W[k] = (kdL * L[k] / rho0) * (1.0f + etaL * std::fabs(C[k]));
+    for (uint32_t k = 0; k < count; ++k) W[k] = diffusionWeight(kdL, L[k], rho0, etaL, std::fabs(C[k]));
     float a = 0.0f, sq = 0.0f;
     for (uint32_t k = 0; k < count; ++k) {  // cloth neighbours only
       if (!samePiece(i, index[begin + k])) continue;
@@ -125,15 +125,10 @@ void exchangeFlows(const Model& model, const State& state, const NeighborLists& 
       const bool same = (j < clothL) & (P[j] == phi);
       const uint32_t jj = same ? j : static_cast<uint32_t>(i);  // S, sigma and V hold cloth only
       const double diff = static_cast<double>(SL[jj]) - static_cast<double>(si);
-      const float base = kdL * L[k] / rho0;
       // cos of the flow direction with gravity: from j to i when S_j > S_i, else from i to j
       const float cosFlow = diff > 0.0 ? C[k] : -C[k];
-      const float sgj = SG[jj], vj = VL[jj];
-      const float minSigma = sgj < sgi ? sgj : sgi;  // std::min(sigma_i, sigma_j)
-      const float minV = vj < vi ? vj : vi;          // std::min(V_i, V_j)
-      const double coef =
-          static_cast<double>(kappaL) * minSigma * (base * (1.0f + etaL * cosFlow)) * minV / cL;
-      T[k] = coef * diff;  // +-0 for a pair of another piece (jj = i, diff = 0)
+      const float wij = diffusionWeight(kdL, L[k], rho0, etaL, cosFlow);
+      T[k] = diffusionExchange(kappaL, sgi, SG[jj], wij, vi, VL[jj], cL, diff);  // +-0 for another piece (jj = i)
     }
     double dm = 0.0;
     for (uint32_t k = 0; k < count; ++k) dm += T[k];

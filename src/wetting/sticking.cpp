@@ -65,7 +65,7 @@ Vec3 stickingForce(const StickingInputs& in, const NeighborLists& nb, int64_t nc
     const uint32_t j = J[k];
     const bool isCloth = j < cloth;
     const uint32_t jj = isCloth ? j : self;
-    touching += isCloth & (S[jj] > 0.0f) & !onRest(jj, 0.5f * (hi + H[jj])) ? 1 : 0;
+    touching += isCloth & (S[jj] > 0.0f) & !onRest(jj, pairRadius(hi, H[jj])) ? 1 : 0;
   }
   if (touching == 0) return f;
 #pragma omp simd
@@ -74,7 +74,7 @@ Vec3 stickingForce(const StickingInputs& in, const NeighborLists& nb, int64_t nc
     const bool isCloth = j < cloth;
     const uint32_t jj = isCloth ? j : self;  // water entries read i's own row, then drop out
     const float sj = S[jj];
-    const float hij = 0.5f * (hi + H[jj]);  // pairRadius
+    const float hij = pairRadius(hi, H[jj]);
     const float coef = stickingCoefficient(si, sj, stL, strengthL, rateL);  // 0 for a dry neighbour
     const float rx = X[3 * jj] - xi, ry = X[3 * jj + 1] - yi, rz = X[3 * jj + 2] - zi;  // x_j - x_i
     const float r2 = rx * rx + (ry * ry + rz * rz);

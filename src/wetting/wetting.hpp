@@ -160,6 +160,21 @@ void finishWetting(const Model& model, State& state, WettingScratch& s);
 // between neighbouring particles of the same piece so the held total is conserved (NOTES.md)
 void diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
 
+// the pair terms of diffusion, called by both of its loops and the tests (selects only, for `omp simd`):
+// w_ij = kappa^d lap W_ij / rho0 (1 + eta^d cos) (Eq. 12 with kappa_i^d = kappa_j^d), cos along the
+// flow (the constraint's step takes |cos|)
+inline float diffusionWeight(float kd, float lap, float rho0, float eta, float cosine) {
+  return (kd * lap / rho0) * (1.0f + eta * cosine);
+}
+// the water entering i from j in one iteration, kappa^s min(sigma_i, sigma_j) w_ij min(V_i, V_j) / c
+// (S_j - S_i) (kg): Eq. 15-17 as a pairwise exchange (docs/models.md), so i's gain is j's loss exactly
+inline double diffusionExchange(float kappaS, float sigmaI, float sigmaJ, float wij, float vI, float vJ, double c,
+                                double sjMinusSi) {
+  const float minSigma = sigmaJ < sigmaI ? sigmaJ : sigmaI;  // std::min(sigma_i, sigma_j)
+  const float minV = vJ < vI ? vJ : vI;                      // std::min(V_i, V_j)
+  return static_cast<double>(kappaS) * minSigma * wij * minV / c * sjMinusSi;
+}
+
 // emission.cpp ------------------------------------------------------------------------------------
 
 // Eq. 18's flow from the buffer of an upper particle u to a lower neighbour l over a pass, before u's

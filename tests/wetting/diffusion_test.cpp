@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 using namespace soak;
 using namespace soak::testing;
@@ -146,4 +147,33 @@ TEST(WettingDiffusion, DippedClothWetsLessHighWithGravity) {
   }
   EXPECT_GT(front[0], 0.2f);  // it wicked up above the water line (0.12 m)
   EXPECT_LT(front[1], front[0] - 0.015f);
+}
+
+// the pair terms both diffusion loops call: the exchange is antisymmetric bit for bit (what i gains
+// from j is what j loses to i, with the flow's cos seen the same from both ends), flows down the
+// saturation difference, and gravity speeds water going down (cos > 0) against water going up
+TEST(WettingDiffusion, PairExchangeIsAntisymmetricAndGravityShaped) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float kd = 0.02f, rho0 = 800.0f, eta = 0.5f, kappa = 0.3f;
+  const double c = 4e-4;
+  for (int k = 0; k < 100; ++k) {
+    const float lap = 1e6f * (0.1f + u(rng)), cosIJ = 2.0f * u(rng) - 1.0f;  // cos theta_ij: i below j when > 0
+    const float si = u(rng), sj = u(rng), sgi = 0.1f + u(rng), sgj = 0.1f + u(rng);
+    const float vi = 1e-5f * (0.5f + u(rng)), vj = 1e-5f * (0.5f + u(rng));
+    const double dIJ = double(sj) - double(si), dJI = double(si) - double(sj);
+    // the flow's cos with gravity from each end, as exchangeFlows takes it (cos theta_ji = -cos theta_ij)
+    const float wFromI = diffusionWeight(kd, lap, rho0, eta, dIJ > 0.0 ? cosIJ : -cosIJ);
+    const float wFromJ = diffusionWeight(kd, lap, rho0, eta, dJI > 0.0 ? -cosIJ : cosIJ);
+    ASSERT_EQ(wFromI, wFromJ) << k;
+    const double intoI = diffusionExchange(kappa, sgi, sgj, wFromI, vi, vj, c, dIJ);
+    const double intoJ = diffusionExchange(kappa, sgj, sgi, wFromJ, vj, vi, c, dJI);
+    EXPECT_EQ(intoI, -intoJ) << k;
+    EXPECT_GE(intoI * dIJ, 0.0) << k;  // down the saturation difference
+    const double expected = double(kappa) * std::min(sgi, sgj) * double(wFromI) * std::min(vi, vj) / c * dIJ;
+    EXPECT_NEAR(intoI, expected, 1e-6 * std::fabs(expected)) << k;
+  }
+  EXPECT_GT(diffusionWeight(kd, 1e6f, rho0, eta, 0.8f), diffusionWeight(kd, 1e6f, rho0, eta, 0.0f));
+  EXPECT_LT(diffusionWeight(kd, 1e6f, rho0, eta, -0.8f), diffusionWeight(kd, 1e6f, rho0, eta, 0.0f));
+  EXPECT_FLOAT_EQ(diffusionWeight(kd, 1e6f, rho0, 0.0f, 0.8f), kd * 1e6f / rho0);  // no gravity factor
 }
