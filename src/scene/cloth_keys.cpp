@@ -13,11 +13,6 @@
 
 namespace soak {
 
-std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
-}
-
 namespace {
 
 namespace fs = std::filesystem;

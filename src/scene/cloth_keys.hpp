@@ -31,7 +31,4 @@ std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::stri
                                    const std::string& baseDir, int maxVertices, bool shaoWetting, const Bodies& bodies,
                                    const std::vector<Collider>& colliders);
 
-// a's keys then b's: the keys of the other types, which ObjectReader::finish names as misplaced
-std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
-
 }  // namespace soak

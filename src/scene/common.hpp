@@ -1,4 +1,4 @@
-// helpers shared by the scene readers (scene.cpp and chen_keys.cpp)
+// helpers shared by the scene readers (scene.cpp, cloth_keys.cpp and chen_keys.cpp)
 #pragma once
 #include <soak/model.hpp>
 
@@ -12,6 +12,8 @@
 namespace soak {
 
 std::string fmtVec(const Vec3& v);
+// a's keys then b's: the keys of the other types, which ObjectReader::finish names as misplaced
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
 Quat axisAngle(const Vec3& unitAxis, float degrees);
 // max > min in every component, else an error at maxPath
 bool checkOrdered(ErrorLog& log, const std::string& maxPath, const std::string& minName, const Vec3& lo,

@@ -27,6 +27,11 @@ namespace soak {
 
 std::string fmtVec(const Vec3& v) { return fmt::format("[{}, {}, {}]", v.x(), v.y(), v.z()); }
 
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 Quat axisAngle(const Vec3& unitAxis, float degrees) {
   return Quat(Eigen::AngleAxisf(degrees * kPi / 180.0f, unitAxis)).normalized();
 }

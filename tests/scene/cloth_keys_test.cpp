@@ -1,0 +1,124 @@
+// the "cloth" entries of a scene (src/scene/cloth_keys.cpp): rectangle and OBJ meshes placed as asked,
+// pins (corners, vertices, a region) on the right particles, and their errors naming file and path
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "scene/scene_support.hpp"
+
+namespace soak {
+namespace {
+
+using namespace soak::testing;
+
+TEST(SceneBuild, RectangleCornersArePinnedAtTheRightParticles) {
+  // a tilted rectangle: u along z, v along (1, 1, 0)/sqrt 2, so every corner sits at a distinct place
+  const Scene s = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "center": [1, 2, 3], "size": [0.6, 0.4],
+      "resolution": [7, 5], "axisU": [0, 0, 2], "axisV": [1, 1, 0]}, "pin": {"corners": [1, 2]}}]})");
+  const Vec3 c(1, 2, 3), u(0, 0, 1), v = Vec3(1, 1, 0).normalized();
+  const Vec3 corner1 = c + 0.3f * u - 0.2f * v, corner2 = c - 0.3f * u + 0.2f * v;
+  int found = 0;
+  for (int i = 0; i < s.model.numCloth; ++i) {
+    const Vec3& x = s.state.particles.x[size_t(i)];
+    const bool atCorner = (x - corner1).norm() < 1e-5f || (x - corner2).norm() < 1e-5f;
+    EXPECT_EQ(s.state.particles.invMass[size_t(i)] == 0.0f, atCorner) << "particle " << i;
+    found += atCorner;
+  }
+  EXPECT_EQ(found, 2);
+}
+
+TEST(SceneBuild, PinRegionSelectsVerticesByRestPosition) {
+  // 5 x 3 grid over x in [-0.2, 0.2], z in [-0.1, 0.1]: the region x >= 0.15 holds one column (3)
+  const Scene s = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.4, 0.2], "resolution": [5, 3]},
+      "pin": {"region": {"min": [0.15, -1, -1], "max": [1, 1, 1]}}}]})");
+  int pinned = 0;
+  for (int i = 0; i < s.model.numCloth; ++i) {
+    const bool inRegion = s.model.clothRestPosition[size_t(i)].x() >= 0.15f;
+    EXPECT_EQ(s.model.clothPinned[size_t(i)] == 1, inRegion);
+    pinned += s.model.clothPinned[size_t(i)];
+  }
+  EXPECT_EQ(pinned, 3);
+}
+
+TEST(SceneBuild, ObjMeshIsScaledRotatedTranslatedRelativeToTheSceneFile) {
+  TempDir dir;
+  dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  const std::string path = dir.write("scene.json", R"({"cloth": [{"mesh": {"type": "obj", "path": "quad.obj",
+      "scale": 2, "translate": [0, 0, 5], "rotate": {"axis": [0, 0, 1], "degrees": 90}},
+      "pin": {"vertices": [2]}}]})");
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.model.numCloth, 4);
+  // vertex 1 (1, 0, 0) -> scale (2, 0, 0) -> rotate 90 deg about z (0, 2, 0) -> translate (0, 2, 5)
+  EXPECT_TRUE(s.model.clothRestPosition[1].isApprox(Vec3(0, 2, 5), 1e-5f));
+  EXPECT_EQ(s.model.clothPinned[2], 1);
+  EXPECT_EQ(s.name, "scene");
+}
+
+TEST(SceneErrors, PinOutOfRange) {
+  EXPECT_HAS(errorWith("cloth.0.pin.vertices=[0, 12]"),
+             "test.json: at cloth[0].pin.vertices[1]: expected an integer in [0, 11], got 12");
+  EXPECT_HAS(errorWith("cloth.0.pin.corners=[4]"), "at cloth[0].pin.corners[0]: expected an integer in [0, 3], got 4");
+  EXPECT_HAS(errorWith("cloth.0.pin.region={\"min\": [5, 5, 5], \"max\": [6, 6, 6]}"),
+             "at cloth[0].pin.region: expected a box containing at least one vertex");
+}
+
+TEST(SceneErrors, MissingObjNamesThePathItTried) {
+  TempDir dir;
+  const std::string text = R"({"cloth": [{"mesh": {"type": "obj", "path": "nowhere/shirt.obj"}}]})";
+  const std::string msg = loadError(text, {}, dir.path.string());
+  EXPECT_HAS(msg, "test.json: at cloth[0].mesh.path: expected the path of an existing OBJ file, got \"nowhere/shirt.obj\"");
+  EXPECT_HAS(msg, "(tried \"" + (dir.path / "nowhere/shirt.obj").string() + "\")");
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "obj", "path": "a.obj"}, "pin": {"corners": [0]}}]})", {},
+                       (fs::path(SOAK_SOURCE_DIR) / "scenes").string()),
+             "at cloth[0].mesh.path: expected the path of an existing OBJ file");
+}
+
+TEST(SceneErrors, CornersAreOnlyForRectangles) {
+  TempDir dir;
+  dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string text = R"({"cloth": [{"mesh": {"type": "obj", "path": "tri.obj"}, "pin": {"corners": [0]}}]})";
+  EXPECT_HAS(loadError(text, {}, dir.path.string()), "at cloth[0].pin.corners: expected no corners on an obj mesh");
+}
+
+TEST(SceneErrors, NonManifoldObjIsRefusedWithFileAndPath) {
+  TempDir dir;
+  // three triangles share the edge (1, 2): a fin that no cloth can be
+  dir.write("fin.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
+  const std::string scene = dir.write("fin.json", R"({"cloth": [{"name": "fin", "mesh": {"type": "obj", "path": "fin.obj"}}]})");
+  try {
+    loadScene(scene);
+    FAIL() << "a non-manifold mesh loaded";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_HAS(msg, scene + ": at cloth[0].mesh");
+    EXPECT_HAS(msg, "shared by 3 triangles");
+  }
+}
+
+TEST(ClothKeys, MaterialKeysReachThePieceAndPbdKeysAreRefusedOnAnImplicitOne) {
+  const Scene s = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.2], "resolution": [4, 3]},
+      "material": {"particleMass": 0.004, "restDensity": 650, "stretchCompliance": 1e-7, "bendCompliance": 2e-4,
+                   "damping": 0.3, "thickness": 0.003, "friction": 0.6, "selfCollision": false, "tetherSlack": 0.05}}]})");
+  const ClothMaterial& m = s.model.pieces.at(0).material;
+  EXPECT_FLOAT_EQ(m.particleMass, 0.004f);
+  EXPECT_FLOAT_EQ(m.restDensity, 650.0f);
+  EXPECT_FLOAT_EQ(m.stretchCompliance, 1e-7f);
+  EXPECT_FLOAT_EQ(m.bendCompliance, 2e-4f);
+  EXPECT_FLOAT_EQ(m.damping, 0.3f);
+  EXPECT_FLOAT_EQ(m.thickness, 0.003f);
+  EXPECT_FLOAT_EQ(m.friction, 0.6f);
+  EXPECT_FALSE(m.selfCollision);
+  EXPECT_FLOAT_EQ(m.tetherSlack, 0.05f);
+  EXPECT_FLOAT_EQ(s.state.particles.mass.at(0), 0.004f);  // a dry cloth particle has the material's mass
+  const std::string msg = loadError(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.2],
+      "resolution": [4, 3]}, "solver": "implicit", "material": {"damping": 0.3, "selfCollision": true}}]})");
+  EXPECT_HAS(msg, "test.json: at cloth[0].material.damping: expected no damping on a piece with \"solver\": \"implicit\"");
+  EXPECT_HAS(msg, "at cloth[0].material.selfCollision: expected false on a piece with \"solver\": \"implicit\"");
+  EXPECT_HAS(errorWith("cloth.0.material.friction=1.5"), "at cloth[0].material.friction: expected a number in [0, 1], got 1.5");
+}
+
+}  // namespace
+}  // namespace soak
