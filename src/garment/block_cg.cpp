@@ -86,7 +86,9 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
   CgResult result;
   if (!(delta0 > 0.0)) delta0 = deltaNew;
   if (!(delta0 > 0.0)) {
-    result.converged = true;
+    // nothing to solve (b and r are zero), or r^T P^-1 r < 0: the matrix is not positive definite
+    result.converged = delta0 == 0.0;
+    result.breakdown = !result.converged;
     return result;
   }
   const double tol2 = options.tolerance * options.tolerance;

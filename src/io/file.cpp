@@ -18,7 +18,9 @@ std::ofstream openForWrite(const std::string& path) {
 }
 
 void finishWrite(std::ofstream& out, const std::string& path) {
-  errno = 0;
+  // a write that already failed (a block larger than the stream's buffer goes out at once) left its
+  // reason in errno: kept for the message
+  if (out.good()) errno = 0;
   out.flush();
   const bool ok = out.good();
   out.close();

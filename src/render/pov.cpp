@@ -183,6 +183,7 @@ Bounds colliderBounds(const Collider& c, const ColliderPose& pose) {
       break;
   }
   Bounds world;
+  if (local.empty()) return world;  // a mesh without its distance grid: nothing to frame
   for (int k = 0; k < 8; ++k) {
     const Vec3 corner((k & 1) ? local.hi.x() : local.lo.x(), (k & 2) ? local.hi.y() : local.lo.y(),
                       (k & 4) ? local.hi.z() : local.lo.z());

@@ -179,12 +179,9 @@ TEST(GarmentCg, IndefiniteMatrixIsReportedAsABreakdown) {
   for (const Vec3d& v : x) EXPECT_TRUE(v.allFinite());
 }
 
-// BUG (src/garment/block_cg.cpp, filteredPcg): when b^T P^-1 b is negative (a diagonal block that is not
-// positive definite, e.g. A = -I) the guard meant for a zero right-hand side, `if (!(delta0 > 0.0))
-// { converged = true; return; }`, reports a converged solve with 0 iterations while x is untouched and
-// A x != b. A matrix that is not positive definite should come back as a breakdown (or not converged),
-// as the header promises ("breakdown: the matrix is not positive definite"). Enable once fixed.
-TEST(GarmentCg, DISABLED_NegativeDefiniteDiagonalIsNotReportedAsConverged) {
+// a matrix that is not positive definite (A = -I: b^T P^-1 b < 0) is reported as a breakdown, not as
+// a converged solve that left x untouched
+TEST(GarmentCg, NegativeDefiniteDiagonalIsNotReportedAsConverged) {
   const Eigen::MatrixXd dense = -Eigen::MatrixXd::Identity(6, 6);
   const BlockMatrix A = blocksOf(dense);
   std::vector<Vec3d> b(2, Vec3d(1, 2, 3)), x(2, Vec3d::Zero());
@@ -195,6 +192,7 @@ TEST(GarmentCg, DISABLED_NegativeDefiniteDiagonalIsNotReportedAsConverged) {
   const double error = (ax[0] - b[0]).norm() + (ax[1] - b[1]).norm();
   // either it solved the system, or it did not say it did
   EXPECT_TRUE(!res.converged || error < 1e-8) << "converged with |Ax - b| = " << error;
+  EXPECT_TRUE(res.breakdown);
 }
 
 // stopped by maxIterations: not converged, the iterations and the residual at exit reported; a zero

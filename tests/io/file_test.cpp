@@ -99,11 +99,9 @@ TEST(IoFile, AFullDiskIsAWriteFailureNamingTheFile) {
   EXPECT_THROW(finishWrite(out, "/dev/full"), Error);
 }
 
-// BUG (src/io/file.cpp, finishWrite): the reason of a failed write is taken from errno after finishWrite
-// resets it, so when the write that failed came before finishWrite (a block larger than the stream's buffer
-// is written at once) the message says "I/O error" instead of "No space left on device": a full disk is
-// not named as such. Enable once the reason of the failing write is kept.
-TEST(IoFile, DISABLED_AFullDiskIsNamedAsSuchWhateverTheWriteSize) {
+// a full disk is named as such, also when the failing write was a block written at once (larger than
+// the stream's buffer) before finishWrite
+TEST(IoFile, AFullDiskIsNamedAsSuchWhateverTheWriteSize) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
   try {
     writeTextFile("/dev/full", std::string(size_t(1) << 16, 'x'));

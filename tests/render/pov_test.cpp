@@ -345,12 +345,8 @@ TEST(RenderPov, BoundsOfPointsAndColliders) {
   EXPECT_LT((tb.hi - Vec3(0.35f, 0.2f, 0.3f)).norm(), 1e-6f);
 }
 
-// BUG (src/render/pov.cpp, colliderBounds): a Mesh collider without a distance grid leaves its local box
-// empty (lo = +1e30, hi = -1e30), and the eight corners of that empty box are then transformed and added
-// as points, so the world bounds span -1e30 .. 1e30 instead of being empty: the `if (c.sdf)` guard does not
-// keep such a collider out of the camera framing. (The scene loader always builds the grid, so only a
-// hand-made Model meets it.) Enable once an empty local box gives empty world bounds.
-TEST(RenderPov, DISABLED_AMeshColliderWithoutItsGridHasNoBounds) {
+// a Mesh collider without its distance grid has empty bounds, so it does not stretch the camera's framing
+TEST(RenderPov, AMeshColliderWithoutItsGridHasNoBounds) {
   Collider mesh;
   mesh.shape = ColliderShape::Mesh;
   const Bounds b = colliderBounds(mesh, ColliderPose{});
