@@ -17,6 +17,33 @@ using namespace soak;
 
 namespace {
 
+// colliders of each shape, at rest (the pose is given beside them)
+Collider sphereOf(float radius) {
+  Collider c;
+  c.shape = ColliderShape::Sphere;
+  c.radius = radius;
+  return c;
+}
+Collider capsuleOf(float radius, float halfHeight) {
+  Collider c;
+  c.shape = ColliderShape::Capsule;
+  c.radius = radius;
+  c.halfHeight = halfHeight;
+  return c;
+}
+Collider boxOf(const Vec3& halfExtents) {
+  Collider c;
+  c.shape = ColliderShape::Box;
+  c.halfExtents = halfExtents;
+  return c;
+}
+Collider containerOf(const Vec3& halfExtents, float wallThickness) {
+  Collider c = boxOf(halfExtents);
+  c.shape = ColliderShape::Container;
+  c.wallThickness = wallThickness;
+  return c;
+}
+
 // the poly6 kernel's mass beyond a plane at signed distance d, integrated numerically (Simpson, 2000
 // intervals) from its definition: W(r) = 315 / (64 pi h^9) (h^2 - r^2)^3, so the mass in the slab at
 // height z is pi/4 * 315 / (64 pi h^9) (h^2 - z^2)^4 dz
@@ -48,20 +75,8 @@ TEST(Fluid, BoundaryPartBoxesSkipOnlyPartsBeyondTheSupport) {
   // capsules and a tilted container's walls, at points around and inside them
   Model model;
   const Quat tilt(Eigen::AngleAxisf(0.6f, Vec3(1, 2, 3).normalized()));
-  Collider box;
-  box.shape = ColliderShape::Box;
-  box.halfExtents = Vec3(0.3f, 0.05f, 0.2f);
-  Collider sphere;
-  sphere.shape = ColliderShape::Sphere;
-  sphere.radius = 0.15f;
-  Collider capsule;
-  capsule.shape = ColliderShape::Capsule;
-  capsule.radius = 0.05f;
-  capsule.halfHeight = 0.2f;
-  Collider container;
-  container.shape = ColliderShape::Container;
-  container.halfExtents = Vec3(0.25f, 0.15f, 0.2f);
-  container.wallThickness = 0.04f;
+  const Collider box = boxOf(Vec3(0.3f, 0.05f, 0.2f)), sphere = sphereOf(0.15f), capsule = capsuleOf(0.05f, 0.2f);
+  const Collider container = containerOf(Vec3(0.25f, 0.15f, 0.2f), 0.04f);
   model.colliders = {box, sphere, capsule, container};
   std::vector<ColliderPose> poses(4);
   const Vec3 at[4] = {Vec3(0, 0, 0), Vec3(0.4f, 0.1f, 0), Vec3(-0.4f, 0, 0.2f), Vec3(0, -0.5f, 0.1f)};
@@ -127,10 +142,7 @@ TEST(PbdBoundary, APlaneGivesTheHalfSpaceIntegralOfTheKernel) {
 // an open container is five boxes; in the corner of its cavity, d1 above the floor and d2 from a side
 // wall, water sees both: phi = 1 - (1 - Phi(d1)) (1 - Phi(d2)), with the product rule's gradient
 TEST(PbdBoundary, AContainerCornerIsTheUnionOfItsWalls) {
-  Collider box;
-  box.shape = ColliderShape::Container;
-  box.halfExtents = Vec3(0.3f, 0.2f, 0.25f);
-  box.wallThickness = 0.05f;
+  const Collider box = containerOf(Vec3(0.3f, 0.2f, 0.25f), 0.05f);
   ColliderPose pose;
   pose.translation = Vec3(1.0f, 0.5f, -0.5f);
   pose.rotation = Quat(Eigen::AngleAxisf(0.7f, Vec3::UnitY()));
@@ -172,16 +184,7 @@ TEST(PbdBoundary, PartBoxesAreTheWorldBoundsOfEachShape) {
   ColliderPose pose;
   pose.translation = Vec3(0.2f, 1.0f, -0.4f);
   pose.rotation = tilt;
-  Collider sphere;
-  sphere.shape = ColliderShape::Sphere;
-  sphere.radius = 0.15f;
-  Collider capsule;
-  capsule.shape = ColliderShape::Capsule;
-  capsule.radius = 0.05f;
-  capsule.halfHeight = 0.2f;
-  Collider box;
-  box.shape = ColliderShape::Box;
-  box.halfExtents = Vec3(0.3f, 0.1f, 0.2f);
+  const Collider sphere = sphereOf(0.15f), capsule = capsuleOf(0.05f, 0.2f), box = boxOf(Vec3(0.3f, 0.1f, 0.2f));
   const Eigen::Matrix3f r = tilt.toRotationMatrix();
   const Vec3 expected[3] = {Vec3::Constant(0.15f), r.col(1).cwiseAbs() * 0.2f + Vec3::Constant(0.05f),
                             r.cwiseAbs() * box.halfExtents};

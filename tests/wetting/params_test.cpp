@@ -11,12 +11,6 @@ using namespace soak::testing;
 
 namespace {
 
-const char* kHanging = R"({
-  "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.4, 0.4],
-             "resolution": [21, 21], "axisU": [1, 0, 0], "axisV": [0, 1, 0]}, "pin": {"corners": [2, 3]}}],
-  "wetting": {}
-})";
-
 std::string errorOf(const std::vector<std::string>& overrides) {
   try {
     sceneFromJson(kHanging, overrides);

@@ -16,12 +16,6 @@ using namespace soak::testing;
 
 namespace {
 
-const char* kHanging = R"({
-  "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.4, 0.4],
-             "resolution": [21, 21], "axisU": [1, 0, 0], "axisV": [0, 1, 0]}, "pin": {"corners": [2, 3]}}],
-  "wetting": {}
-})";
-
 // V of a particle whose neighbours lie at the given distances (m), itself included: 1 / sum W(r, h), with
 // W(r, h) = 315 / (64 pi h^9) (h^2 - r^2)^3 (poly6) in double
 double volumeOf(const std::vector<double>& distances, double h) {

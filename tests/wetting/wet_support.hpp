@@ -55,6 +55,13 @@ inline std::string rectangleJson(const std::string& name, const Vec3& center, fl
          "], \"axisU\": " + axisU + ", \"axisV\": " + axisV + "}, \"pin\": " + pin + "}";
 }
 
+// a 0.4 m sheet of 21 x 21 hanging from its two top corners, wetting on with Table 1's defaults
+inline const char* kHanging = R"({
+  "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.4, 0.4],
+             "resolution": [21, 21], "axisU": [1, 0, 0], "axisV": [0, 1, 0]}, "pin": {"corners": [2, 3]}}],
+  "wetting": {}
+})";
+
 // pins every vertex of a piece (a box around the whole scene)
 inline const char* kPinAll = R"({"region": {"min": [-5, -5, -5], "max": [5, 5, 5]}})";
 
