@@ -46,8 +46,13 @@ double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::v
   return orderedSum(partial);
 }
 
-CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
-                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w) {
+namespace {
+
+// the solve's start: the block-Jacobi preconditioner P^-1 (the inverse of each diagonal block, the
+// first of its row), delta0 = filter(b)^T P^-1 filter(b), the scale the residual is measured against,
+// r = filter(b - A x), c = filter(P^-1 r) and deltaNew = r^T c
+void startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
+              const std::vector<Vec3d>& x, CgScratch& w, double& delta0, double& deltaNew) {
   const int64_t n = A.rows;
   w.r.resize(static_cast<size_t>(n));
   w.c.resize(static_cast<size_t>(n));
@@ -55,8 +60,6 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
   w.s.resize(static_cast<size_t>(n));
   w.precond.resize(static_cast<size_t>(n));
   w.partial.resize(static_cast<size_t>(n));
-  // block-Jacobi preconditioner P^-1: the inverse of each diagonal block (the first of its row).
-  // delta0 = filter(b)^T P^-1 filter(b) is the scale the residual is measured against.
   parallelFor(n, [&](int64_t i) {
     bool ok = false;
     Eigen::Matrix3d inv;
@@ -65,7 +68,7 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
     w.precond[i] = ok ? inv : Eigen::Matrix3d::Identity();
     w.partial[i] = constrained[i] ? 0.0 : b[i].dot(w.precond[i] * b[i]);
   });
-  double delta0 = orderedSum(w.partial);
+  delta0 = orderedSum(w.partial);
 
   // r = filter(b - A x), c = filter(P^-1 r)
   rowsFor(n, [&](int64_t i) {
@@ -81,8 +84,16 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
     w.c[i] = w.precond[i] * w.r[i];
     w.partial[i] = w.r[i].dot(w.c[i]);
   });
-  double deltaNew = orderedSum(w.partial);
+  deltaNew = orderedSum(w.partial);
+}
 
+}  // namespace
+
+CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
+                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w) {
+  const int64_t n = A.rows;
+  double delta0 = 0.0, deltaNew = 0.0;
+  startPcg(A, b, constrained, x, w, delta0, deltaNew);
   CgResult result;
   if (!(delta0 > 0.0)) delta0 = deltaNew;
   if (!(delta0 > 0.0)) {
