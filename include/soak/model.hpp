@@ -44,7 +44,8 @@ struct Collider {
   // mesh: the signed distance grid of a closed OBJ in the local frame, shared by copies of the
   // collider (read-only, so sharing is safe and a Model copy stays cheap)
   std::shared_ptr<const SdfGrid> sdf;
-  float friction = 0.3f;               // 0..1: fraction of the tangential slip removed on contact
+  float friction = 0.3f;               // kinetic Coulomb coefficient, mixed with the particle's (core/friction.hpp)
+  float staticFriction = 0.3f;         // static Coulomb coefficient, >= friction
   float restitution = 0.0f;            // 0..1: normal velocity kept, reversed, on contact
   std::vector<Keyframe> keys;          // at least one; linear translation, slerp rotation, clamped ends
 };

@@ -31,6 +31,7 @@ struct FrameStats {
   uint64_t couplingContacts = 0;
   uint64_t emittedParticles = 0;
   uint64_t removedParticles = 0;
+  uint64_t colliderPutBack = 0;
   double densityRatioSum = 0.0;
   float maxSpeed = 0.0f;             // m/s
   GarmentStats garment;

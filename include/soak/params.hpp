@@ -28,7 +28,7 @@ struct WaterParams {
   float tensileK = 0.0f;          // artificial pressure k (Macklin 2013 Eq. 13); off: see docs/models.md on Eq. 6
   float tensileDq = 0.2f;         // artificial pressure delta q, as a fraction of h
   int tensileN = 4;               // artificial pressure exponent n
-  float boundaryFriction = 0.1f;  // tangential damping of water against colliders, 0..1
+  float boundaryFriction = 0.1f;  // Coulomb coefficient of water against colliders (static = kinetic), mixed with theirs
 };
 
 struct ClothMaterial {
@@ -38,7 +38,8 @@ struct ClothMaterial {
   float bendCompliance = 1.0e-3f;   // 1/(N m), XPBD compliance of Eq. 9
   float damping = 0.0f;             // 1/s, velocity damping of the cloth
   float thickness = 0.01f;          // m, d of Eq. 21 and the self-collision distance
-  float friction = 0.3f;            // Coulomb-like friction against colliders, 0..1
+  float friction = 0.3f;            // kinetic Coulomb coefficient against colliders, mixed with theirs
+  float staticFriction = 0.3f;      // static Coulomb coefficient, >= friction
   bool selfCollision = true;
   float tetherSlack = 0.0f;         // fraction a particle may stray beyond its rest path length from the pins
 };

@@ -57,6 +57,7 @@ struct StepStats {
   uint64_t couplingContacts = 0;    // water-triangle contacts resolved (Eq. 21)
   uint64_t emittedParticles = 0;    // water particles created this step
   uint64_t removedParticles = 0;    // water particles that left the domain this step
+  uint64_t colliderPutBack = 0;     // particles put back out of a collider they were in or went through
   float meanDensityRatio = 0.0f;    // mean rho_i / rho_0 over water particles after the solve
   float maxSpeed = 0.0f;            // m/s over all particles
   GarmentStats garment;

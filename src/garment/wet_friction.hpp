@@ -7,6 +7,8 @@
 
 #include <soak/garment_params.hpp>
 
+#include "core/friction.hpp"
+
 namespace soak {
 
 // friction coefficient after `wetTime` seconds wet (the dry value for wetTime <= 0 or not finite):
@@ -16,14 +18,6 @@ namespace soak {
 // with S(s) = 3 s^2 - 2 s^3: continuous with a continuous slope, the extremum exactly at tau1
 float wetFriction(double wetTime, const WetFrictionParams& f);
 
-// Coulomb friction at a contact, velocity level: vRel is the velocity relative to the surface
-// after the normal correction, n the unit normal, normalDeltaV >= 0 the normal velocity change the
-// contact applied this step. The tangential part shrinks by at most mu * normalDeltaV (kinetic
-// friction) and stops when that is enough (static friction). Returns the new relative velocity.
-Vec3 coulombFriction(const Vec3& vRel, const Vec3& n, float mu, float normalDeltaV);
-
-// mixes a fabric and a collider coefficient as sqrt(a b) (Box2D's b2MixFriction): zero on either
-// side gives a frictionless contact
-float mixFriction(float fabric, float collider);
+// Coulomb friction and the mixing of a fabric and a collider coefficient: core/friction.hpp
 
 }  // namespace soak

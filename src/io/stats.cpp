@@ -14,6 +14,7 @@ void FrameStats::add(const StepStats& s) {
   couplingContacts += s.couplingContacts;
   emittedParticles += s.emittedParticles;
   removedParticles += s.removedParticles;
+  colliderPutBack += s.colliderPutBack;
   densityRatioSum += s.meanDensityRatio;
   maxSpeed = std::max(maxSpeed, s.maxSpeed);
   garment += s.garment;
@@ -90,6 +91,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
   j["removedAtBounds"] = {{"frame", fs.removedParticles}, {"total", state.ledger.particlesRemovedAtBounds}};
   j["emittedParticles"] = fs.emittedParticles;
   j["couplingContacts"] = fs.couplingContacts;
+  j["colliderPutBack"] = fs.colliderPutBack;
   if (fs.steps > 0)
     j["meanDensityRatio"] = fs.densityRatioSum / fs.steps;
   else

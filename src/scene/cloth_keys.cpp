@@ -21,7 +21,7 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   const ClothMaterial d;
   ClothMaterial m;
   if (solver == ClothSolver::Implicit) {  // the KES laws, Rayleigh damping and wet friction replace these
-    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction", "tetherSlack"})
+    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction", "staticFriction", "tetherSlack"})
       if (r.has(key))
         r.log().error(r.pathOf(key), fmt::format("expected no {} on a piece with \"solver\": \"implicit\" (a PBD "
                                                  "key; set the garment section instead, docs/scene-format.md)",
@@ -37,7 +37,7 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   m.bendCompliance = r.number("bendCompliance", d.bendCompliance, Range::nonNegative());
   m.damping = r.number("damping", d.damping, Range::nonNegative());
   m.thickness = r.number("thickness", d.thickness, Range::positive());
-  m.friction = r.number("friction", d.friction, Range::unit());
+  readFriction(r, d.friction, m.friction, m.staticFriction);
   m.selfCollision = r.boolean("selfCollision", d.selfCollision) && solver == ClothSolver::Pbd;
   m.tetherSlack = r.number("tetherSlack", d.tetherSlack, Range::nonNegative());
   r.finish();

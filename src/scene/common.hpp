@@ -50,6 +50,9 @@ std::vector<Key> readKeyframes(ObjectReader& r, const std::string& what, ReadBod
   return out;
 }
 
+// "friction" (kinetic Coulomb coefficient, >= 0) and "staticFriction" (>= friction, default: friction)
+void readFriction(ObjectReader& r, float defaultKinetic, float& kinetic, float& staticCoef);
+
 // a path relative to the scene file's folder
 std::string resolvePath(const std::string& file, const std::string& baseDir);
 

@@ -79,6 +79,14 @@ std::string resolvePath(const std::string& file, const std::string& baseDir) {
   return resolved.string();
 }
 
+void readFriction(ObjectReader& r, float defaultKinetic, float& kinetic, float& staticCoef) {
+  kinetic = r.number("friction", defaultKinetic, Range::nonNegative());
+  staticCoef = r.number("staticFriction", kinetic, Range::nonNegative());
+  if (staticCoef < kinetic)
+    r.log().error(r.pathOf("staticFriction"),
+                  fmt::format("expected a number >= friction ({}), got {}", kinetic, staticCoef));
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -118,7 +126,7 @@ void readWater(ObjectReader r, WaterParams& w) {
   w.tensileDq = t.number("dq", d.tensileDq, Range{0.0, 1.0, false, true});
   w.tensileN = t.integer("n", d.tensileN, Range::between(1, 32));  // the solver takes powers up to 63
   t.finish();
-  w.boundaryFriction = r.number("boundaryFriction", d.boundaryFriction, Range::unit());
+  w.boundaryFriction = r.number("boundaryFriction", d.boundaryFriction, Range::nonNegative());
   r.finish();
 }
 
@@ -284,7 +292,7 @@ std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, 
       mine = {"path", "resolution", "padding"};
       break;
   }
-  c.friction = r.number("friction", d.friction, Range::unit());
+  readFriction(r, d.friction, c.friction, c.staticFriction);
   c.restitution = r.number("restitution", d.restitution, Range::unit());
   c.keys = readPose(r, c.shape == ColliderShape::Plane);
   std::vector<std::string> others;

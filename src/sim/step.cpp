@@ -66,7 +66,8 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
   clock.lap(ms.cloth, StagePart::clothSolve);
   clothSelfCollision(model, p, ws.neighbors, ws.cloth);
   clock.lap(ms.cloth, StagePart::clothSelfCollision);
-  projectColliders(model, ws.poses, p, ws.pbdParticles, h, ws.contactNormal, ws.colliderBound);  // friction
+  stats.colliderPutBack += projectColliders(model, ws.poses, p, ws.pbdParticles, h, ws.contactNormal,
+                                            ws.colliderBound);                       // Coulomb friction
   clock.lap(ms.colliders);
   updateCouplingStiffness(model, state, ws.coupling.triangleStiffness);             // Eq. 22: wetter cloth lets water through
   findCouplingCandidates(model, p, ws.coupling);                                    // triangles near each water particle's path

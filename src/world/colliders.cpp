@@ -91,17 +91,6 @@ float localDistance(const Collider& c, const Vec3& p, Vec3* n) {
   return p.y();
 }
 
-// friction fraction of a particle of `phase` against collider c
-float frictionFraction(const Model& model, const Collider& c, int32_t phase) {
-  float mu = c.friction;
-  if (!isWater(phase)) {
-    const int k = clothPiece(phase);
-    if (k >= 0 && k < static_cast<int>(model.pieces.size()))
-      mu = 0.5f * (c.friction + model.pieces[k].material.friction);
-  }
-  return std::clamp(mu, 0.0f, 1.0f);
-}
-
 }  // namespace
 
 ColliderPose colliderPose(const Collider& c, double t) {
@@ -228,102 +217,6 @@ void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const f
       const float v = d[i] - kDistanceBoundSlack;
       o[i] = v < o[i] ? v : o[i];
     }
-  });
-}
-
-float contactMargin(const Model& model, int32_t phase) {
-  if (isWater(phase)) return 0.5f * model.water.spacing;
-  const int k = clothPiece(phase);
-  if (k < 0 || k >= static_cast<int>(model.pieces.size())) return 1e-4f;
-  return std::max(0.5f * model.pieces[k].material.thickness, 1e-4f);
-}
-
-// Contact and friction model (position level, once per substep):
-//   d = sdf(x*) - margin; if d < 0 then x* <- x* - d n            (push out to the margin)
-//   dx = (x* - x) - v_col(x*) dt                                   (slip relative to the collider)
-//   x* <- x* - mu (dx - (dx.n) n)                                  (remove the fraction mu of the
-//                                                                  tangential slip)
-// A thin wall crossed past its middle in one substep is nearest its far face: a particle that started
-// clear of the collider on the opposite face and moved along the nearest face's normal is instead put
-// on the plane of the face it came in by (docs/models.md, "Colliders").
-// mu = collider.friction for water, 0.5 (collider.friction + cloth material friction) for cloth.
-// mu = 1 makes the particle move tangentially with the collider surface, mu = 0 lets it slide.
-void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
-                      std::vector<Vec3>& contactNormal) {
-  std::vector<float> distanceBound;
-  projectColliders(model, poses, p, {{0, static_cast<int64_t>(p.size())}}, dt, contactNormal, distanceBound);
-}
-
-void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
-                      const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
-                      std::vector<float>& distanceBound) {
-  const int64_t n = static_cast<int64_t>(p.size());
-  contactNormal.assign(p.size(), Vec3::Zero());
-  const size_t numColliders = std::min(model.colliders.size(), poses.size());
-  if (numColliders == 0 || n == 0) return;
-  // most particles are far from every collider: a vectorised lower bound of the distance first, and
-  // the exact contact below only where it is within the margin (the same result: a particle beyond
-  // its margin from every collider is left alone by the loop below)
-  distanceBound.assign(p.size(), std::numeric_limits<float>::max());
-  for (size_t c = 0; c < numColliders; ++c)
-    colliderDistanceBounds(model.colliders[c], poses[c], p.xPred[0].data(), n, distanceBound.data());
-  parallelForRanges(moved, [&](int64_t i) {
-    if (!(p.invMass[i] > 0.0f)) return;
-    const float margin = contactMargin(model, p.phase[i]);
-    if (distanceBound[i] >= margin) return;
-    Vec3 xp = p.xPred[i];
-    for (size_t c = 0; c < numColliders; ++c) {
-      const Collider& col = model.colliders[c];
-      Vec3 nrm;
-      float d = colliderDistance(col, poses[c], xp, &nrm) - margin;
-      if (d >= 0.0f) continue;
-      // a thin wall crossed past its middle in one substep is nearest its far face: back through the face it came in by
-      const Vec3 from = p.x[i] + poses[c].velocityAt(p.x[i]) * dt;  // the start, carried with the collider
-      if ((xp - from).dot(nrm) > 0.0f) {
-        Vec3 n0;
-        const float s0 = colliderDistance(col, poses[c], from, &n0);
-        if (s0 >= 0.0f && n0.dot(nrm) < 0.0f) {
-          d = (xp - from).dot(n0) + s0 - margin;  // xp's distance to the entry face's plane, less the margin
-          if (d >= 0.0f) continue;
-          nrm = n0;
-        }
-      }
-      xp -= d * nrm;
-      const Vec3 dx = (xp - p.x[i]) - poses[c].velocityAt(xp) * dt;
-      const Vec3 tangential = dx - dx.dot(nrm) * nrm;
-      xp -= frictionFraction(model, col, p.phase[i]) * tangential;
-      contactNormal[i] = nrm;
-    }
-    p.xPred[i] = xp;
-  });
-}
-
-// the collider that made the contact is re-found as the one closest to x* (smallest distance minus
-// margin, lowest index on ties), so no per-particle collider index has to be carried
-void applyColliderRestitution(const Model& model, const std::vector<ColliderPose>& poses,
-                              const std::vector<Vec3>& contactNormal, Particles& p) {
-  const size_t numColliders = std::min(model.colliders.size(), poses.size());
-  if (numColliders == 0) return;
-  const int64_t n = static_cast<int64_t>(std::min(p.size(), contactNormal.size()));
-  parallelFor(n, [&](int64_t i) {
-    const Vec3& nrm = contactNormal[i];
-    if (nrm.squaredNorm() == 0.0f || !(p.invMass[i] > 0.0f)) return;
-    const Vec3 xp = p.xPred[i];
-    size_t best = 0;
-    float bestDist = colliderDistance(model.colliders[0], poses[0], xp, nullptr);
-    for (size_t c = 1; c < numColliders; ++c) {
-      const float d = colliderDistance(model.colliders[c], poses[c], xp, nullptr);
-      if (d < bestDist) {
-        bestDist = d;
-        best = c;
-      }
-    }
-    const Vec3 vCol = poses[best].velocityAt(xp);
-    const float vn = (p.v[i] - vCol).dot(nrm);
-    if (vn >= 0.0f) return;
-    // new relative normal velocity = -e vn
-    const float e = std::clamp(model.colliders[best].restitution, 0.0f, 1.0f);
-    p.v[i] -= (1.0f + e) * vn * nrm;
   });
 }
 

@@ -1,5 +1,5 @@
-// rigid colliders (plane, box, open container, sphere, capsule) with kinematic keyframed motion,
-// friction and restitution. Shared by both cloth solvers and the water.
+// rigid colliders (plane, box, open container, sphere, capsule, mesh) with kinematic keyframed motion;
+// contact with Coulomb friction and restitution (collider_contact.cpp). Shared by both cloth solvers and the water.
 #pragma once
 #include <soak/model.hpp>
 #include <soak/state.hpp>
@@ -39,15 +39,18 @@ void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const f
 float contactMargin(const Model& model, int32_t phase);
 
 // pushes the predicted position x* of every particle in `moved` (but kinematic ones) out of every
-// collider (distance >= margin), removing the fraction `friction` of the tangential motion relative to
-// the collider over this substep. contactNormal[i] is set to the world normal of the last contact of
-// particle i, or zero. distanceBound: scratch, a lower bound of each particle's distance to the nearest
-// collider, so that the particles far from every collider skip the exact test
-void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
+// collider (distance >= margin; a container wall by wall) and applies Coulomb friction to its motion
+// relative to the collider over this substep (collider_contact.cpp). A particle that started clear
+// is put on the face its path x -> x* entered by, found along the path, so no speed carries it
+// through a wall. contactNormal[i] is set to the world normal of the last contact of particle i, or
+// zero. distanceBound: scratch, a lower bound of each particle's distance to the nearest collider, so
+// that the particles far from every collider skip the exact test. Returns the number of particles
+// put back: x* inside a collider's surface, its path through one, or its start inside one
+uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
                       const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
                       std::vector<float>& distanceBound);
 // the same for every particle
-void projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
+uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal);
 
 // after v = (x* - x)/dt: a particle in contact that moves into the collider along the normal gets

@@ -233,6 +233,7 @@ std::vector<Collider> buildMannequin(const MannequinParams& params, const std::v
         c.radius = parts[p].radius;
         c.halfHeight = parts[p].halfHeight;
         c.friction = friction;
+        c.staticFriction = friction;
         c.restitution = 0.0f;
       }
     }

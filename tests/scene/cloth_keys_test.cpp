@@ -117,7 +117,15 @@ TEST(ClothKeys, MaterialKeysReachThePieceAndPbdKeysAreRefusedOnAnImplicitOne) {
       "resolution": [4, 3]}, "solver": "implicit", "material": {"damping": 0.3, "selfCollision": true}}]})");
   EXPECT_HAS(msg, "test.json: at cloth[0].material.damping: expected no damping on a piece with \"solver\": \"implicit\"");
   EXPECT_HAS(msg, "at cloth[0].material.selfCollision: expected false on a piece with \"solver\": \"implicit\"");
-  EXPECT_HAS(errorWith("cloth.0.material.friction=1.5"), "at cloth[0].material.friction: expected a number in [0, 1], got 1.5");
+  EXPECT_HAS(errorWith("cloth.0.material.friction=-0.5"), "at cloth[0].material.friction: expected a number >= 0, got -0.5");
+  // static friction defaults to the kinetic coefficient and may not be below it, on a collider as on cloth
+  EXPECT_HAS(loadError(kSmall, {"cloth.0.material.friction=0.6", "cloth.0.material.staticFriction=0.5"}),
+             "at cloth[0].material.staticFriction: expected a number >= friction (0.6), got 0.5");
+  const Scene u = fromString(kSmall, {"cloth.0.material.friction=0.6"});
+  EXPECT_FLOAT_EQ(u.model.pieces[0].material.staticFriction, 0.6f);
+  const Scene t = fromString(kSmall, {"cloth.0.material.friction=0.6", "cloth.0.material.staticFriction=0.8"});
+  EXPECT_FLOAT_EQ(t.model.pieces[0].material.friction, 0.6f);
+  EXPECT_FLOAT_EQ(t.model.pieces[0].material.staticFriction, 0.8f);
 }
 
 }  // namespace

@@ -1,0 +1,220 @@
+// contact of particles with the rigid colliders: push-out to a margin along the path the particle
+// came by, Coulomb friction (core/friction.hpp), restitution (docs/models.md, "Colliders")
+#include "world/colliders.hpp"
+
+#include "core/friction.hpp"
+#include "world/container.hpp"
+#include "world/mesh_sdf.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+namespace soak {
+
+namespace {
+
+// a convex piece of a collider that the contact treats on its own: the collider itself, or one wall
+// of a container (an open container is concave: against its single distance a particle in a corner
+// would be pushed out of the floor on one substep and out of the wall on the next, and jitter)
+struct ContactPart {
+  Collider shape;     // the collider, or one wall of a container as a box
+  ColliderPose pose;  // of the shape (for a wall, its centre); the velocity field is the owner's
+  size_t owner = 0;   // index of the collider in the model and in poses
+  float thickness = 0.0f;  // m, the thinnest the part is (a plane: infinite)
+};
+
+float thicknessOf(const Collider& c) {
+  switch (c.shape) {
+    case ColliderShape::Plane: return std::numeric_limits<float>::infinity();
+    case ColliderShape::Sphere:
+    case ColliderShape::Capsule: return 2.0f * c.radius;
+    case ColliderShape::Box: return 2.0f * c.halfExtents.minCoeff();
+    case ColliderShape::Container: return c.wallThickness;
+    case ColliderShape::Mesh: return c.sdf ? 2.0f * c.sdf->cellSize : std::numeric_limits<float>::infinity();
+  }
+  return 0.0f;
+}
+
+std::vector<ContactPart> contactParts(const Model& model, const std::vector<ColliderPose>& poses, size_t count) {
+  std::vector<ContactPart> parts;
+  for (size_t c = 0; c < count; ++c) {
+    const Collider& col = model.colliders[c];
+    if (col.shape != ColliderShape::Container) {
+      parts.push_back({col, poses[c], c, thicknessOf(col)});
+      continue;
+    }
+    Vec3 centers[kContainerWalls], halves[kContainerWalls];
+    containerWalls(col, centers, halves);
+    for (int k = 0; k < kContainerWalls; ++k) {
+      ContactPart wall;
+      wall.shape.shape = ColliderShape::Box;
+      wall.shape.halfExtents = halves[k];
+      wall.pose = poses[c];
+      wall.pose.translation = poses[c].translation + poses[c].rotation * centers[k];
+      wall.owner = c;
+      wall.thickness = thicknessOf(wall.shape);
+      parts.push_back(wall);
+    }
+  }
+  return parts;
+}
+
+// the Coulomb coefficients of a particle of `phase` against collider c: the collider's mixed with the
+// water's boundaryFriction or the cloth material's (mixFriction, sqrt(a b))
+FrictionCoefficients frictionOf(const Model& model, const Collider& c, int32_t phase) {
+  const FrictionCoefficients collider{c.staticFriction, c.friction};
+  if (isWater(phase)) return mixFriction(collider, FrictionCoefficients{model.water.boundaryFriction, model.water.boundaryFriction});
+  const int k = clothPiece(phase);
+  if (k < 0 || k >= static_cast<int>(model.pieces.size())) return collider;
+  const ClothMaterial& m = model.pieces[k].material;
+  return mixFriction(collider, FrictionCoefficients{m.staticFriction, m.friction});
+}
+
+// the first point of the path from -> to within `margin` of the part, found by samples closer than
+// the part is thick (plus the two margins) and 12 bisections; false when the whole path stays clear
+bool firstEntry(const ContactPart& part, const Vec3& from, const Vec3& to, float margin, Vec3* entry) {
+  const float length = (to - from).norm();
+  const float step = 0.9f * (part.thickness + 2.0f * margin);
+  const int samples = std::isfinite(step) && step > 0.0f ? std::max(1, static_cast<int>(std::ceil(length / step))) : 1;
+  float outside = 0.0f;
+  for (int k = 1; k <= samples; ++k) {
+    const float s = static_cast<float>(k) / static_cast<float>(samples);
+    if (colliderDistance(part.shape, part.pose, from + s * (to - from), nullptr) >= margin) {
+      outside = s;
+      continue;
+    }
+    float inside = s;
+    for (int b = 0; b < 12; ++b) {
+      const float mid = 0.5f * (outside + inside);
+      (colliderDistance(part.shape, part.pose, from + mid * (to - from), nullptr) >= margin ? outside : inside) = mid;
+    }
+    *entry = from + outside * (to - from);
+    return true;
+  }
+  return false;
+}
+
+struct ContactResult {
+  bool touched = false;
+  bool putBack = false;  // x* was inside the part's surface, or its path went through the part
+};
+
+// one particle against one part: x* is put on the tangent plane, at the margin, of the face its path
+// entered by (a particle already within the margin at the start of the substep is pushed out along
+// the nearest normal), then Coulomb friction acts on its slip relative to the surface
+ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose, const Vec3& x, Vec3& xp,
+                          float margin, float dt, FrictionCoefficients mu, Vec3* normal) {
+  ContactResult r;
+  Vec3 nrm;
+  const float rawEnd = colliderDistance(part.shape, part.pose, xp, &nrm);
+  const Vec3 from = x + ownerPose.velocityAt(x) * dt;  // the start, carried with the collider
+  const float length = (xp - from).norm();
+  float d = rawEnd - margin;
+  // clear at the end and too short a path to have stepped over the part: no contact
+  if (d >= 0.0f && length < part.thickness + 2.0f * margin) return r;
+  Vec3 n0;
+  const float startDistance = colliderDistance(part.shape, part.pose, from, &n0);
+  if (startDistance >= 0.0f) {  // started outside: back on the face the path entered by
+    Vec3 entry = from;            // already within the margin at the start: the face it rests on
+    if (startDistance >= margin && !firstEntry(part, from, xp, margin, &entry)) return r;
+    const float entryDistance = colliderDistance(part.shape, part.pose, entry, &nrm);
+    d = (xp - entry).dot(nrm) + entryDistance - margin;  // x*'s height over the entry face's tangent plane, less the margin
+    if (d >= 0.0f) return r;                              // grazed the margin and left it again
+    r.putBack = rawEnd < 0.0f || d < -(part.thickness + 2.0f * margin);
+  } else if (d >= 0.0f) {
+    return r;
+  } else {
+    r.putBack = true;  // found inside: out along the nearest normal
+  }
+  xp -= d * nrm;
+  if (colliderDistance(part.shape, part.pose, xp, &n0) < margin - 1e-6f) {  // a concave mesh: the nearest face as well
+    xp -= (colliderDistance(part.shape, part.pose, xp, &n0) - margin) * n0;
+  }
+  const Vec3 slip = (xp - x) - ownerPose.velocityAt(xp) * dt;  // motion relative to the surface
+  xp += coulombFriction(slip, nrm, mu, -d) - slip;                // the normal push -d limits the friction
+  *normal = nrm;
+  r.touched = true;
+  return r;
+}
+
+}  // namespace
+
+float contactMargin(const Model& model, int32_t phase) {
+  if (isWater(phase)) return 0.5f * model.water.spacing;
+  const int k = clothPiece(phase);
+  if (k < 0 || k >= static_cast<int>(model.pieces.size())) return 1e-4f;
+  return std::max(0.5f * model.pieces[k].material.thickness, 1e-4f);
+}
+
+uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
+                          std::vector<Vec3>& contactNormal) {
+  std::vector<float> distanceBound;
+  return projectColliders(model, poses, p, {{0, static_cast<int64_t>(p.size())}}, dt, contactNormal, distanceBound);
+}
+
+uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
+                          const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
+                          std::vector<float>& distanceBound) {
+  const int64_t n = static_cast<int64_t>(p.size());
+  contactNormal.assign(p.size(), Vec3::Zero());
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  if (numColliders == 0 || n == 0) return 0;
+  // most particles are far from every collider: a vectorised lower bound of the distance of x* first;
+  // a point of the path is at most |x* - start| nearer, so beyond margin + that nothing is touched
+  distanceBound.assign(p.size(), std::numeric_limits<float>::max());
+  for (size_t c = 0; c < numColliders; ++c)
+    colliderDistanceBounds(model.colliders[c], poses[c], p.xPred[0].data(), n, distanceBound.data());
+  const std::vector<ContactPart> parts = contactParts(model, poses, numColliders);
+  std::atomic<uint64_t> putBack{0};
+  parallelForRanges(moved, [&](int64_t i) {
+    if (!(p.invMass[i] > 0.0f)) return;
+    const float margin = contactMargin(model, p.phase[i]);
+    float carried = 0.0f;  // how far the colliders carry the start in this substep
+    for (size_t c = 0; c < numColliders; ++c) carried = std::max(carried, poses[c].velocityAt(p.x[i]).norm() * dt);
+    Vec3 xp = p.xPred[i];
+    if (distanceBound[i] >= margin + (xp - p.x[i]).norm() + carried) return;
+    int caught = 0;
+    for (const ContactPart& part : parts) {
+      const Collider& owner = model.colliders[part.owner];
+      const ContactResult r = contactWith(part, poses[part.owner], p.x[i], xp, margin, dt,
+                                          frictionOf(model, owner, p.phase[i]), &contactNormal[i]);
+      caught += r.putBack ? 1 : 0;
+    }
+    p.xPred[i] = xp;
+    if (caught) putBack.fetch_add(1, std::memory_order_relaxed);
+  });
+  return putBack.load();
+}
+
+// the collider that made the contact is re-found as the one closest to x* (smallest distance minus
+// margin, lowest index on ties), so no per-particle collider index has to be carried
+void applyColliderRestitution(const Model& model, const std::vector<ColliderPose>& poses,
+                              const std::vector<Vec3>& contactNormal, Particles& p) {
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  if (numColliders == 0) return;
+  const int64_t n = static_cast<int64_t>(std::min(p.size(), contactNormal.size()));
+  parallelFor(n, [&](int64_t i) {
+    const Vec3& nrm = contactNormal[i];
+    if (nrm.squaredNorm() == 0.0f || !(p.invMass[i] > 0.0f)) return;
+    const Vec3 xp = p.xPred[i];
+    size_t best = 0;
+    float bestDist = colliderDistance(model.colliders[0], poses[0], xp, nullptr);
+    for (size_t c = 1; c < numColliders; ++c) {
+      const float d = colliderDistance(model.colliders[c], poses[c], xp, nullptr);
+      if (d < bestDist) {
+        bestDist = d;
+        best = c;
+      }
+    }
+    const Vec3 vCol = poses[best].velocityAt(xp);
+    const float vn = (p.v[i] - vCol).dot(nrm);
+    if (vn >= 0.0f) return;
+    // new relative normal velocity = -e vn
+    const float e = std::clamp(model.colliders[best].restitution, 0.0f, 1.0f);
+    p.v[i] -= (1.0f + e) * vn * nrm;
+  });
+}
+
+}  // namespace soak
