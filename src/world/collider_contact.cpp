@@ -96,24 +96,28 @@ bool firstEntry(const ContactPart& part, const Vec3& from, const Vec3& to, float
   return false;
 }
 
+constexpr int kContactPasses = 3;
+
 struct ContactResult {
   bool touched = false;
   bool putBack = false;  // x* was inside the part's surface, or its path went through the part
 };
 
 // one particle against one part: x* is put on the tangent plane, at the margin, of the face its path
-// entered by (a particle already within the margin at the start of the substep is pushed out along
-// the nearest normal), then Coulomb friction acts on its slip relative to the surface
+// entered by (a particle already within the margin at the start of the substep: of the face it rests
+// on; one found inside: out along the nearest normal), then Coulomb friction acts on its slip
+// relative to the surface. `repeat`: a later pass over the parts, which only pushes out what the
+// other parts pushed in (the friction of this substep's contacts has acted)
 ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose, const Vec3& x, Vec3& xp,
-                          float margin, float dt, FrictionCoefficients mu, Vec3* normal) {
+                          float margin, float dt, FrictionCoefficients mu, bool repeat, Vec3* normal) {
   ContactResult r;
   Vec3 nrm;
   const float rawEnd = colliderDistance(part.shape, part.pose, xp, &nrm);
   const Vec3 from = x + ownerPose.velocityAt(x) * dt;  // the start, carried with the collider
   const float length = (xp - from).norm();
   float d = rawEnd - margin;
-  // clear at the end and too short a path to have stepped over the part: no contact
-  if (d >= 0.0f && length < part.thickness + 2.0f * margin) return r;
+  // clear at the end and shorter than the part is thick: it cannot have passed through it
+  if (d >= 0.0f && length < part.thickness) return r;
   Vec3 n0;
   const float startDistance = colliderDistance(part.shape, part.pose, from, &n0);
   if (startDistance >= 0.0f) {  // started outside: back on the face the path entered by
@@ -121,9 +125,9 @@ ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose
     if (startDistance >= margin && !firstEntry(part, from, xp, margin, &entry)) return r;
     const float entryDistance = colliderDistance(part.shape, part.pose, entry, &nrm);
     d = (xp - entry).dot(nrm) + entryDistance - margin;  // x*'s height over the entry face's tangent plane, less the margin
-    if (d >= 0.0f) return r;                              // grazed the margin and left it again
+    if (d >= (repeat ? -1e-6f * margin : 0.0f)) return r;  // grazed the margin and left it again
     r.putBack = rawEnd < 0.0f || d < -(part.thickness + 2.0f * margin);
-  } else if (d >= 0.0f) {
+  } else if (d >= (repeat ? -1e-6f * margin : 0.0f)) {
     return r;
   } else {
     r.putBack = true;  // found inside: out along the nearest normal
@@ -132,8 +136,10 @@ ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose
   if (colliderDistance(part.shape, part.pose, xp, &n0) < margin - 1e-6f) {  // a concave mesh: the nearest face as well
     xp -= (colliderDistance(part.shape, part.pose, xp, &n0) - margin) * n0;
   }
-  const Vec3 slip = (xp - x) - ownerPose.velocityAt(xp) * dt;  // motion relative to the surface
-  xp += coulombFriction(slip, nrm, mu, -d) - slip;                // the normal push -d limits the friction
+  if (!repeat) {
+    const Vec3 slip = (xp - x) - ownerPose.velocityAt(xp) * dt;  // motion relative to the surface
+    xp += coulombFriction(slip, nrm, mu, -d) - slip;                // the normal push -d limits the friction
+  }
   *normal = nrm;
   r.touched = true;
   return r;
@@ -175,12 +181,19 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
     for (size_t c = 0; c < numColliders; ++c) carried = std::max(carried, poses[c].velocityAt(p.x[i]).norm() * dt);
     Vec3 xp = p.xPred[i];
     if (distanceBound[i] >= margin + (xp - p.x[i]).norm() + carried) return;
+    // a push out of one part can put x* into another met before it (a container's wall after its
+    // neighbour's): up to three passes, the later ones only pushing out
     int caught = 0;
-    for (const ContactPart& part : parts) {
-      const Collider& owner = model.colliders[part.owner];
-      const ContactResult r = contactWith(part, poses[part.owner], p.x[i], xp, margin, dt,
-                                          frictionOf(model, owner, p.phase[i]), &contactNormal[i]);
-      caught += r.putBack ? 1 : 0;
+    for (int pass = 0; pass < kContactPasses; ++pass) {
+      bool touched = false;
+      for (const ContactPart& part : parts) {
+        const Collider& owner = model.colliders[part.owner];
+        const ContactResult r = contactWith(part, poses[part.owner], p.x[i], xp, margin, dt,
+                                            frictionOf(model, owner, p.phase[i]), pass > 0, &contactNormal[i]);
+        caught += r.putBack ? 1 : 0;
+        touched = touched || r.touched;
+      }
+      if (!touched || parts.size() == 1) break;
     }
     p.xPred[i] = xp;
     if (caught) putBack.fetch_add(1, std::memory_order_relaxed);

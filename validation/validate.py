@@ -1,0 +1,181 @@
+#!/usr/bin/python3
+"""soak's validation suite: runs the scenes of validation/ (and one paper scene) with build/soak,
+compares them with experiments and closed forms, and writes docs/validation.md with its plots in
+docs/validation/. Each case states its target and the measured error.
+
+usage: validation/validate.py [--out DIR] [--only NAME ...]     (about 10 minutes on 2 cores)
+"""
+import argparse
+import datetime
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import soakrun
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DOCS = os.path.join(soakrun.ROOT, "docs")
+G = 9.81
+# Martin & Moyce 1952, square column (n^2 = 1): surge front Z = z/a at T = t sqrt(g/a)
+MARTIN_MOYCE = np.array([(0.43, 1.11), (0.62, 1.22), (0.80, 1.44), (0.97, 1.67), (1.14, 1.89), (1.29, 2.11),
+                         (1.45, 2.33), (1.62, 2.56), (1.76, 2.78), (1.93, 3.00), (2.07, 3.22), (2.24, 3.44),
+                         (2.40, 3.67), (2.54, 3.89), (2.71, 4.11), (2.87, 4.33), (3.04, 4.56)])
+
+
+def water_frames(out):
+    """(stats line, water vertices) of every frame that has water"""
+    st = soakrun.stats(out)
+    for f in soakrun.frames(out):
+        w = soakrun.read_vertices(os.path.join(out, f"water_{f:04d}.ply"))
+        if len(w):
+            yield st[f], w
+
+
+def kinetic(w):
+    return 0.5 * float(np.sum(w["mass"] * (w["vx"] ** 2 + w["vy"] ** 2 + w["vz"] ** 2)))
+
+
+def dam_break(work):
+    """the surge front against Martin & Moyce at 1, 2 and 4 substeps; target: within 10% over T in [0.4, 3.0]"""
+    a, x0 = 0.3, -0.9
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(MARTIN_MOYCE[:, 0], MARTIN_MOYCE[:, 1], "ko", label="Martin & Moyce 1952")
+    rows = []
+    for substeps in (1, 2, 4):
+        out = soakrun.run(os.path.join(HERE, "dam_break.json"), os.path.join(work, f"dam_break_{substeps}"),
+                          [f"solver.substeps={substeps}"])
+        T, Z = [], []
+        for s, w in water_frames(out):
+            T.append(s["time"] * np.sqrt(G / a))
+            Z.append((w["x"].max() - x0) / a)
+        T, Z = np.array(T), np.array(Z)
+        inside = (MARTIN_MOYCE[:, 0] >= 0.4) & (MARTIN_MOYCE[:, 0] <= 3.0)
+        ref = MARTIN_MOYCE[inside]
+        err = np.interp(ref[:, 0], T, Z) / ref[:, 1] - 1.0
+        worst = float(err[np.argmax(np.abs(err))])
+        ax.plot(T, Z, label=f"soak, {substeps} substep{'s' if substeps > 1 else ''} (worst {100 * worst:+.1f}%)")
+        rows.append((f"dam break front, {substeps} substep(s)", "within 10% for T in [0.4, 3.0]",
+                     f"worst {100 * worst:+.1f}%", abs(worst) <= 0.10))
+    ax.set(xlabel="T = t sqrt(g/a)", ylabel="Z = z/a", title="Dam break, square column a = 0.3 m", xlim=(0, 3.5))
+    ax.legend()
+    return rows, save(fig, "dam_break.png")
+
+
+def rest(work):
+    """a settled block: kinetic energy below 1e-3 J per 10k particles within 3 s, density within 1% of 1"""
+    out = soakrun.run(os.path.join(HERE, "rest_block.json"), os.path.join(work, "rest"))
+    t, ke, rho = [], [], []
+    for s, w in water_frames(out):
+        t.append(s["time"])
+        ke.append(kinetic(w) * 1e4 / len(w))
+        rho.append(s["meanDensityRatio"])
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    ax[0].semilogy(t, ke)
+    ax[0].axhline(1e-3, color="k", ls="--", label="target 1e-3 J")
+    ax[0].set(xlabel="t (s)", ylabel="kinetic energy per 10k particles (J)", title="Settling block")
+    ax[0].legend()
+    ax[1].plot(t, rho)
+    ax[1].axhspan(0.99, 1.01, color="0.9", label="target: within 1%")
+    ax[1].set(xlabel="t (s)", ylabel="mean density ratio", title="Compression")
+    ax[1].legend()
+    at3 = ke[int(np.searchsorted(t, 3.0 - 1e-6))]
+    return [("rest: kinetic energy at 3 s", "< 1e-3 J per 10k particles", f"{at3:.3g} J", at3 < 1e-3),
+            ("rest: mean density ratio", "within 1% of 1", f"{rho[-1]:.4f}", abs(rho[-1] - 1) <= 0.01)], \
+        save(fig, "rest.png")
+
+
+def leaks(work):
+    """the settling block at 1 substep of 0.015 s and of 0.03 s: no water may leave the container"""
+    rows = []
+    for dt in (0.015, 0.03):
+        out = soakrun.run(os.path.join(HERE, "rest_block.json"), os.path.join(work, f"leak_{dt}"),
+                          [f"solver.dt={dt}", "output.stepsPerFrame=1"], frames=int(round(1.5 / dt)))
+        st = soakrun.stats(out)
+        lost = st[-1]["waterMass"]["removedAtBounds"]
+        back = sum(s.get("colliderPutBack", 0) for s in st)
+        rows.append((f"leaks: still pool, dt {dt} s, 1 substep, 1.5 s", "0 kg leaves the container",
+                     f"{lost:.4g} kg ({back} put-backs)", lost == 0))
+    return rows, None
+
+
+def free_fall(work):
+    """a block's centre against y0 - g t^2 / 2 (symplectic Euler: y0 - g t (t + h) / 2)"""
+    out = soakrun.run(os.path.join(HERE, "free_fall.json"), os.path.join(work, "free_fall"))
+    t, y = [], []
+    for s, w in water_frames(out):
+        t.append(s["time"])
+        y.append(float(np.mean(w["y"])))
+    t, y = np.array(t), np.array(y)
+    y0, h = 1.05, 0.015
+    drop = y0 - y
+    err = float(np.max(np.abs(drop - G * t * (t + h) / 2) / (G * t * t / 2)))
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(t, y, "o", ms=3, label="soak, block centre")
+    ax.plot(t, y0 - G * t * t / 2, "k-", label="y0 - g t^2 / 2")
+    ax.set(xlabel="t (s)", ylabel="y (m)", title="Free fall")
+    ax.legend()
+    return [("free fall: drop against the integrator's closed form", "within 0.1%", f"{100 * err:.3f}%",
+             err <= 1e-3)], save(fig, "free_fall.png")
+
+
+def budget(work):
+    """the water ledger of a wetting scene: emitted = free + held + buffers + removed + taken"""
+    out = soakrun.run(os.path.join(soakrun.ROOT, "scenes", "fig1_jet.json"), os.path.join(work, "budget"), frames=40)
+    w = soakrun.stats(out)[-1]["waterMass"]
+    gap = abs(w["total"] - w["emitted"]) / w["emitted"]
+    return [("water budget, Fig. 1 jet, 40 frames", "closes within 1e-6 of the emitted mass",
+             f"{gap:.2g} of {w['emitted']:.3g} kg ({w['heldInCloth']:.3g} kg held)", gap <= 1e-6)], None
+
+
+def save(fig, name):
+    os.makedirs(os.path.join(DOCS, "validation"), exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "validation", name), dpi=110)
+    plt.close(fig)
+    return f"validation/{name}"
+
+
+CASES = {"dam_break": dam_break, "rest": rest, "leaks": leaks, "free_fall": free_fall, "budget": budget}
+
+
+def write_report(results):
+    commit = subprocess.run(["git", "-C", soakrun.ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    lines = ["# Validation", "",
+             f"Written by `validation/validate.py` on {datetime.date.today()} at commit {commit} (build/soak, 2 threads).",
+             "Each row: the case, its target, what soak measured, and whether it holds. Scenes in `validation/`.",
+             "", "| case | target | measured | holds |", "|---|---|---|---|"]
+    for name, (rows, _) in results.items():
+        for case, target, measured, ok in rows:
+            lines.append(f"| {case} | {target} | {measured} | {'yes' if ok else '**no**'} |")
+    lines.append("")
+    for name, (rows, plot) in results.items():
+        if plot:
+            lines += [f"## {name.replace('_', ' ')}", "", CASES[name].__doc__.strip(), "", f"![{name}]({plot})", ""]
+    with open(os.path.join(DOCS, "validation.md"), "w") as f:
+        f.write("\n".join(lines))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(soakrun.ROOT, "out", "validation"), help="run folders")
+    ap.add_argument("--only", nargs="*", choices=sorted(CASES), help="run only these cases (the report lists them only)")
+    args = ap.parse_args()
+    results = {}
+    for name in args.only or CASES:
+        print(f"validation: {name}", flush=True)
+        results[name] = CASES[name](args.out)
+        for case, target, measured, ok in results[name][0]:
+            print(f"  {case}: {measured} (target {target}) {'ok' if ok else 'NOT MET'}", flush=True)
+    write_report(results)
+    print(f"validation: wrote {os.path.join(DOCS, 'validation.md')}")
+
+
+if __name__ == "__main__":
+    main()
