@@ -4,8 +4,9 @@
 
 #include "core/friction.hpp"
 
-#include "world/mesh.hpp"
 #include "world/mesh_sdf.hpp"
+
+#include "support/colliders.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,18 +16,9 @@
 namespace soak {
 namespace {
 
-Collider makeCollider(ColliderShape shape) {
-  Collider c;
-  c.shape = shape;
-  c.keys.push_back(Keyframe{});
-  return c;
-}
-
-void expectVec(const Vec3& a, const Vec3& b, float tol) {
-  EXPECT_NEAR(a.x(), b.x(), tol) << "got " << a.transpose() << " expected " << b.transpose();
-  EXPECT_NEAR(a.y(), b.y(), tol) << "got " << a.transpose() << " expected " << b.transpose();
-  EXPECT_NEAR(a.z(), b.z(), tol) << "got " << a.transpose() << " expected " << b.transpose();
-}
+using testing::cubeMesh;
+using testing::expectVec;
+using testing::makeCollider;
 
 Model planeModel(float friction) {
   Model m;
@@ -243,15 +235,6 @@ TEST(ColliderContact, ContainerEdgePushesOutOfFloorAndWallAtOnce) {
   simulate(m, p, 0.0075f, 40);
   EXPECT_LT(p.v[0].norm(), 1e-4f);
   expectVec(p.x[0], Vec3(0.19f, 0.01f, 0.0f), 1e-5f);
-}
-
-// a closed cube of half size s, outward winding
-TriangleMesh cubeMesh(float s) {
-  TriangleMesh mesh;
-  for (int k = 0; k < 8; ++k) mesh.vertices.push_back(Vec3(k & 1 ? s : -s, k & 2 ? s : -s, k & 4 ? s : -s));
-  mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return mesh;
 }
 
 // no speed up to solver.maxSpeed carries a particle through a collider in one substep: fired at a

@@ -1,6 +1,8 @@
 // colliders: exact signed distances and normals of each shape, keyframed poses and their velocities
 #include "world/colliders.hpp"
 
+#include "support/colliders.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,12 +12,8 @@
 namespace soak {
 namespace {
 
-Collider makeCollider(ColliderShape shape) {
-  Collider c;
-  c.shape = shape;
-  c.keys.push_back(Keyframe{});
-  return c;
-}
+using testing::expectVec;
+using testing::makeCollider;
 
 ColliderPose staticPose(const Vec3& t = Vec3::Zero(), const Quat& q = Quat::Identity()) {
   ColliderPose pose;
@@ -25,12 +23,6 @@ ColliderPose staticPose(const Vec3& t = Vec3::Zero(), const Quat& q = Quat::Iden
 }
 
 Quat aroundAxis(float angle, const Vec3& axis) { return Quat(Eigen::AngleAxisf(angle, axis.normalized())); }
-
-void expectVec(const Vec3& a, const Vec3& b, float tol) {
-  EXPECT_NEAR(a.x(), b.x(), tol) << "got " << a.transpose() << " expected " << b.transpose();
-  EXPECT_NEAR(a.y(), b.y(), tol) << "got " << a.transpose() << " expected " << b.transpose();
-  EXPECT_NEAR(a.z(), b.z(), tol) << "got " << a.transpose() << " expected " << b.transpose();
-}
 
 float dist(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* n = nullptr) {
   Vec3 tmp;

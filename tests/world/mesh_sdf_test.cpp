@@ -3,6 +3,8 @@
 #include "world/colliders.hpp"
 #include "world/mesh_sdf.hpp"
 
+#include "support/colliders.hpp"
+
 #include <soak/error.hpp>
 
 #include <gtest/gtest.h>
@@ -16,14 +18,7 @@
 namespace soak {
 namespace {
 
-// a closed cube of half size h centred at the origin, outward winding
-TriangleMesh cube(float h) {
-  TriangleMesh m;
-  for (int k = 0; k < 8; ++k) m.vertices.push_back(Vec3(k & 1 ? h : -h, k & 2 ? h : -h, k & 4 ? h : -h));
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
+using testing::cubeMesh;
 
 // icosphere of radius r: an icosahedron subdivided `levels` times, vertices on the sphere
 TriangleMesh icosphere(float r, int levels) {
@@ -71,7 +66,7 @@ float boxDistance(const Vec3& p, float h) {
 }
 
 TEST(MeshSdfGrid, CubeObjMatchesTheAnalyticBoxDistanceWithinACell) {
-  const std::string path = writeObj(cube(0.3f), "soak_mesh_sdf_cube.obj");
+  const std::string path = writeObj(cubeMesh(0.3f), "soak_mesh_sdf_cube.obj");
   const float h = 0.02f;
   const Collider c = loadMeshCollider("cube", path, h, 0.1f);
   ASSERT_EQ(c.shape, ColliderShape::Mesh);
@@ -134,16 +129,16 @@ TEST(MeshSdfGrid, SphereMatchesTheAnalyticDistanceAndNormal) {
 }
 
 TEST(MeshSdfGrid, InwardWoundMeshGivesTheSameSigns) {
-  TriangleMesh in = cube(0.3f);
+  TriangleMesh in = cubeMesh(0.3f);
   for (auto& t : in.triangles) std::swap(t[1], t[2]);
-  const SdfGrid a = buildSdfGrid(cube(0.3f), 0.05f, 0.1f, "cube"), b = buildSdfGrid(in, 0.05f, 0.1f, "cube");
+  const SdfGrid a = buildSdfGrid(cubeMesh(0.3f), 0.05f, 0.1f, "cube"), b = buildSdfGrid(in, 0.05f, 0.1f, "cube");
   ASSERT_EQ(a.value.size(), b.value.size());
   for (size_t k = 0; k < a.value.size(); ++k) EXPECT_FLOAT_EQ(a.value[k], b.value[k]);
   EXPECT_LT(sampleSdf(a, Vec3::Zero(), nullptr), -0.29f);
 }
 
 TEST(MeshSdfGrid, OpenMeshIsRefusedNamingTheFile) {
-  TriangleMesh open = cube(0.3f);
+  TriangleMesh open = cubeMesh(0.3f);
   open.triangles.pop_back();
   const std::string path = writeObj(open, "soak_mesh_sdf_open.obj");
   try {
@@ -155,14 +150,14 @@ TEST(MeshSdfGrid, OpenMeshIsRefusedNamingTheFile) {
     EXPECT_NE(msg.find("closed"), std::string::npos) << msg;
   }
   // two triangles running the same way along an edge: not orientable as given
-  TriangleMesh flipped = cube(0.3f);
+  TriangleMesh flipped = cubeMesh(0.3f);
   std::swap(flipped.triangles[0][1], flipped.triangles[0][2]);
   EXPECT_THROW(buildSdfGrid(flipped, 0.05f, 0.1f, "flipped.obj"), Error);
 }
 
 TEST(MeshSdfGrid, RefusesBadResolution) {
-  EXPECT_THROW(buildSdfGrid(cube(0.3f), 0.0f, 0.1f, "cube.obj"), Error);
-  EXPECT_THROW(buildSdfGrid(cube(0.3f), 1e-4f, 0.1f, "cube.obj"), Error);  // 8000^3 nodes
+  EXPECT_THROW(buildSdfGrid(cubeMesh(0.3f), 0.0f, 0.1f, "cube.obj"), Error);
+  EXPECT_THROW(buildSdfGrid(cubeMesh(0.3f), 1e-4f, 0.1f, "cube.obj"), Error);  // 8000^3 nodes
 }
 
 }  // namespace
