@@ -29,6 +29,7 @@ struct WaterParams {
   float tensileDq = 0.2f;         // artificial pressure delta q, as a fraction of h
   int tensileN = 4;               // artificial pressure exponent n
   float boundaryFriction = 0.1f;  // Coulomb coefficient of water against colliders (static = kinetic), mixed with theirs
+  float clothFriction = 0.0f;     // Coulomb coefficient of water on cloth (Eq. 21 contacts; static = kinetic)
 };
 
 struct ClothMaterial {

@@ -4,6 +4,7 @@
 
 #include "pbd/coupling_search.hpp"
 
+#include "core/friction.hpp"
 #include "core/parallel.hpp"
 
 #include <algorithm>
@@ -222,10 +223,25 @@ struct ParticlePass {
     const float kappa = rigidCloth ? 1.0f : iterationFactor(plane.stiffness, iterations);
     const float dl = -C / denom * kappa;
     const Vec3 g = side * plane.normal;
-    dq += wq * dl * g;
-    if (!rigidCloth)
+    // Coulomb friction of the contact (core/friction.hpp): the pair's tangential slip over the substep,
+    // limited by the normal push denom * dl, shared by the inverse masses as the push is
+    const float mu = model.water.clothFriction;
+    float df = 0.0f;
+    Vec3 slipDir = Vec3::Zero();
+    if (mu > 0.0f) {
+      const Vec3 pointMove = bary.x() * (p.xPred[f[0]] - p.x[f[0]]) + bary.y() * (p.xPred[f[1]] - p.x[f[1]]) +
+                             bary.z() * (p.xPred[f[2]] - p.x[f[2]]);
+      const Vec3 slip = (p.xPred[q] + dq + wq * dl * g - xq0) - pointMove;
+      const Vec3 tangential = slip - coulombFriction(slip, g, mu, denom * dl);
+      const float len = tangential.norm();
+      if (len > 0.0f) slipDir = tangential / len, df = -len / denom;
+    }
+    dq += wq * (dl * g + df * slipDir);
+    if (!rigidCloth) {
+      const Vec3 cloth = dl * g + df * slipDir;
       out.push_back({static_cast<uint32_t>(f[0]), static_cast<uint32_t>(f[1]), static_cast<uint32_t>(f[2]),
-                     -wa * bary.x() * dl * g, -wb * bary.y() * dl * g, -wc * bary.z() * dl * g});
+                     -wa * bary.x() * cloth, -wb * bary.y() * cloth, -wc * bary.z() * cloth});
+    }
     return true;
   }
 };

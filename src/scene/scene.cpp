@@ -127,6 +127,7 @@ void readWater(ObjectReader r, WaterParams& w) {
   w.tensileN = t.integer("n", d.tensileN, Range::between(1, 32));  // the solver takes powers up to 63
   t.finish();
   w.boundaryFriction = r.number("boundaryFriction", d.boundaryFriction, Range::nonNegative());
+  w.clothFriction = r.number("clothFriction", d.clothFriction, Range::nonNegative());
   r.finish();
 }
 

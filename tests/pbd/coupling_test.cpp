@@ -149,6 +149,35 @@ TEST(Coupling, RigidCouplingPassHoldsWaterAtDryTrianglesOnly) {
   EXPECT_FLOAT_EQ(run(0.3f, 0.3f), -0.02f);  // wet everywhere: through, the pass skipped
 }
 
+// Coulomb friction between water and cloth (water.clothFriction): a particle that slides 2 cm over a
+// fixed sheet while sinking 5 mm into its thickness keeps 2 cm - mu 5 mm of its slip, all of it at
+// mu = 0, none once mu times the push covers the slip; the normal push is the same
+TEST(Coupling, WaterClothFrictionIsCoulombsLaw) {
+  const auto run = [](float mu) {
+    Scene scene = sceneFromJson(R"({
+      "solver": {"gravity": [0, 0, 0], "domain": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
+      "cloth": [{"mesh": {"type": "rectangle", "center": [0, 0, 0], "size": [0.16, 0.16], "resolution": [9, 9],
+                 "axisU": [1, 0, 0], "axisV": [0, 0, 1]}, "material": {"thickness": 0.01}}]
+    })");
+    scene.model.water.clothFriction = mu;
+    Particles& p = scene.state.particles;
+    p.add(kWaterPhase, 1000, scene.model.water.particleMass, scene.model.water.supportRadius,
+          Vec3(0.0f, 0.01f, 0.025f), Vec3::Zero());
+    p.xPred.back() = Vec3(0.02f, 0.005f, 0.025f);
+    CouplingScratch s;
+    findCouplingCandidates(scene.model, p, s);
+    s.triangleStiffness.assign(scene.model.triangles.size(), 1.0f);
+    solveCoupling(scene.model, p, s, true);
+    return p.xPred.back();
+  };
+  for (float mu : {0.0f, 1.0f, 2.0f, 4.0f, 10.0f}) {
+    const Vec3 x = run(mu);
+    EXPECT_NEAR(x.x(), std::max(0.0f, 0.02f - mu * 0.005f), 1e-5f) << "mu " << mu;
+    EXPECT_NEAR(x.y(), 0.01f, 1e-5f) << "mu " << mu;
+    EXPECT_NEAR(x.z(), 0.025f, 1e-6f) << "mu " << mu;
+  }
+}
+
 TEST(Coupling, Fig3aNoWaterCrossesTheCloth) {
   // Fig. 3(a) of Shao 2017 at full size for 2 simulated seconds, checked after every step: a particle
   // that passed through the sheet and then left the domain is caught too (825 crossings in the first
