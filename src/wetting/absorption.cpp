@@ -213,20 +213,25 @@ void sortGainsByCloth(const Model& model, const State& state, const NeighborList
   }
 }
 
-// each cloth particle takes its gains in that order, with their momentum
+// each cloth particle takes its gains in that order, with their momentum; what does not fit below
+// S^MAX (the remnant of a water particle absorbed whole) goes to its buffer, so S_i <= S^MAX
 void applyGains(const Model& model, State& state, const WettingScratch& s) {
   const int64_t nc = model.numCloth;
   Particles& p = state.particles;
   const std::vector<uint32_t>& first = s.gainFirst;
+  const double c = model.wetting.c, sMax = model.wetting.saturationMax;
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
+    const double most = sMax * s.volume[i] / c;
     for (uint32_t g = first[static_cast<size_t>(i)]; g < first[static_cast<size_t>(i) + 1]; ++g) {
       const double gain = s.gain[s.gainSlot[g]];
       const uint32_t j = s.gainWater[g];
-      state.clothWater[i] += gain;
+      const double held = std::min(gain, std::max(0.0, most - state.clothWater[i]));
+      state.clothWater[i] += held;
+      state.clothBuffer[i] += gain - held;
       // the absorbed water brings its momentum (inelastic: the cloth particle gets heavier)
-      const float mi = p.mass[i], dm = static_cast<float>(gain);
-      if (!model.clothPinned[i]) p.v[i] = (mi * p.v[i] + dm * p.v[j]) / (mi + dm);
-      p.setMass(static_cast<size_t>(i), mi + dm, model.clothPinned[i]);  // dry + held: porosity's sum, in steps
+      const float mi = p.mass[i];
+      setWetMass(model, state, i);
+      if (!model.clothPinned[i]) p.v[i] = (mi * p.v[i] + (p.mass[i] - mi) * p.v[j]) / p.mass[i];
     }
   });
 }

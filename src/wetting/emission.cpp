@@ -457,7 +457,9 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const float maxDrip = std::max(w.maxDripMass > 0.0f ? w.maxDripMass : 4.0f * model.water.particleMass,
                                  w.massThreshold);
   feedHangingDrips(model, state, s, maxDrip);                      // hanging drips grow, or let go
-  return placeNewDrips(model, state, nb, grid, poses, s);          // new drips where there is room
+  const size_t made = placeNewDrips(model, state, nb, grid, poses, s);  // new drips where there is room
+  updateWetMasses(model, state);                                   // the buffers moved: m = dry + held + buffer
+  return made;
 }
 
 // f_p = sum_i kappa^e (m_i + eta^e S_i) (Psi_i / rho0) W(x_ip, h_p) along x_i - x_p (Eq. 19), Psi_i =

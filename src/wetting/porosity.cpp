@@ -44,16 +44,15 @@ std::vector<float> restVolumes(const Model& model, const std::vector<float>& rad
   return volume;
 }
 
-namespace {
-
-// m_i = dry + held + buffer; pinned particles stay kinematic
 void setWetMass(const Model& model, State& state, int64_t i) {
   Particles& p = state.particles;
   const float m = model.clothDryMass[i] + static_cast<float>(state.clothWater[i] + state.clothBuffer[i]);
   p.setMass(static_cast<size_t>(i), m, model.clothPinned[i]);
 }
 
-}  // namespace
+void updateWetMasses(const Model& model, State& state) {
+  parallelFor(model.numCloth, [&](int64_t i) { setWetMass(model, state, i); });
+}
 
 void initWettingState(const Model& model, const std::vector<float>& volume, State& state) {
   const size_t nc = static_cast<size_t>(model.numCloth);
@@ -156,7 +155,7 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
   const Particles& p = state.particles;
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
-  const double c = model.wetting.c;
+  const double c = model.wetting.c, sMax = model.wetting.saturationMax;
   s.volume.resize(static_cast<size_t>(nc));
   state.clothSaturation.resize(static_cast<size_t>(nc));
   // in the loop of the pair geometry, once i's pairs are done: V_i = 1 / sum_k W_ik (Eq. 10) as
@@ -169,6 +168,12 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
       sum += s.pairPoly6[e];
     }
     s.volume[i] = 1.0f / sum;
+    // S <= S^MAX: what a squeezed particle (V_i shrank) cannot hold goes to its buffer (docs/models.md)
+    const double most = sMax * s.volume[i] / c;
+    if (state.clothWater[i] > most) {
+      state.clothBuffer[i] += state.clothWater[i] - most;
+      state.clothWater[i] = most;
+    }
     state.clothSaturation[i] = saturationOf(c, state.clothWater[i], s.volume[i]);
     setWetMass(model, state, i);
   });

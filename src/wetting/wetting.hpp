@@ -113,7 +113,8 @@ void clothVolumes(const Model& model, const std::vector<Vec3>& x, const std::vec
                   const std::vector<int32_t>& phase, const NeighborLists& nb, std::vector<float>& volume);
 
 // Eq. 10 at this pass's positions: V_i, S_i = c m^water_i / V_i, and the wet mass
-// m_i = dry + held + buffer (pinned particles keep inverse mass 0)
+// m_i = dry + held + buffer (pinned particles keep inverse mass 0). Held water beyond S^MAX V_i / c
+// (the cloth was squeezed: V_i shrank) moves to the buffer, so S_i <= S^MAX.
 void updatePorosity(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s);
 
 // fills the pair geometry of the scratch (WettingScratch::pairPoly6 ...) for the cloth pairs of nb at
@@ -123,6 +124,12 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
 // that read the pairs (they do not within a pass: x is committed before the wetting stages).
 void pairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
 void ensurePairGeometry(const Model& model, const Particles& p, const NeighborLists& nb, WettingScratch& s);
+
+// the one home of a cloth particle's mass: m_i = dry + held + buffer (pinned particles stay
+// kinematic); every stage that moves water calls it for the particles it changed
+void setWetMass(const Model& model, State& state, int64_t i);
+// setWetMass of every cloth particle
+void updateWetMasses(const Model& model, State& state);
 
 // S_i = c m / V_i (Eq. 10) of one cloth particle: the one expression every stage that changes the held
 // water uses, so S_i is bit for bit the same wherever it is updated

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace soak;
@@ -101,4 +102,30 @@ TEST(WettingAbsorption, ARemnantBelowTheMinimumMassIsAbsorbedWhole) {
   EXPECT_EQ(scene.state.ledger.particlesAbsorbed, 1u);
   EXPECT_NEAR(accountedWater(scene), before, 1e-12);
   EXPECT_NEAR(scene.state.ledger.heldInCloth, double(0.11f * scene.model.water.particleMass), 1e-12);
+}
+
+TEST(WettingAbsorption, ARemnantAbsorbedWholeNeverFillsPastSMax) {
+  // a nearly full corner particle beside a water particle just above the minimum mass: the particle is
+  // absorbed whole, and what does not fit below S^MAX goes to the buffer (never destroyed)
+  Scene scene = sceneFromJson(R"({"cloth": [)" +
+                              rectangleJson("s", Vec3(0, 0, 0), 0.1f, 0.1f, 6, 6, "[1, 0, 0]", "[0, 0, 1]", kPinAll) +
+                              R"(], "wetting": {"absorption": {"rate": 1.0, "minMassFraction": 0.9}}})");
+  addWater(scene, Vec3(-0.05f, 0.012f, -0.05f));
+  StageRig rig;
+  rig.refresh(scene.state, scene.model);
+  const WettingParams& w = scene.model.wetting;
+  for (int i = 0; i < scene.model.numCloth; ++i)
+    scene.state.clothWater[size_t(i)] = 0.97 * w.saturationMax * rig.s.volume[size_t(i)] / w.c;
+  rig.refresh(scene.state, scene.model);
+  const double before = accountedWater(scene);
+  EXPECT_EQ(absorbWater(scene.model, scene.state, rig.nb, rig.s, scene.model.solver.dt), 1u);
+  finishWetting(scene.model, scene.state, rig.s);
+  computeSaturation(scene.model, scene.state, rig.s, scene.state.clothSaturation);
+  EXPECT_LE(*std::max_element(scene.state.clothSaturation.begin(), scene.state.clothSaturation.end()),
+            w.saturationMax * (1.0f + 1e-6f));
+  EXPECT_GT(sum(scene.state.clothBuffer), 0.0);
+  EXPECT_NEAR(accountedWater(scene), before, 1e-12 * before);
+  for (int i = 0; i < scene.model.numCloth; ++i)  // the mass followed the water
+    EXPECT_EQ(scene.state.particles.mass[i],
+              scene.model.clothDryMass[i] + float(scene.state.clothWater[i] + scene.state.clothBuffer[i]));
 }
