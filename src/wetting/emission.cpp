@@ -207,7 +207,7 @@ void markTransfers(const Model& model, const NeighborLists& nb, const FlowInputs
 
 // Eq. 18's transfer: the buffer of an upper particle u flows to a lower neighbour l at
 // rate cos theta_lu V_u W_lu EW_u; cos theta_lu > 0 (l below u) and W_lu = poly6(|x_l - x_u|^2, h_lu)
-// are the pair's numbers (pairGeometry), the same seen from u or l. rate = min(1, h / rateStep).
+// are the pair's numbers (pairGeometry), the same seen from u or l. rate = h / rateStep of one part (moveBuffersDown).
 
 // s.outScale[u]: the share of each shedding particle's flows its buffer can pay (1 but where strongly
 // compressed cloth asks for more than it holds; 0 where it does not shed)
@@ -311,20 +311,24 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
   });
 }
 
-// 3. the buffers flow down to the neighbours below, over a wetting pass of h
+// 3. the buffers flow down to the neighbours below, over a wetting pass of h: Eq. 18's transfer is a
+// share per rateStep, so a pass is cut into equal parts of at most rateStep, each moving h / parts /
+// rateStep of it (a rate in time for any dt; a pass up to rateStep is one part)
 void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, const FlowInputs& in,
                      WettingScratch& s, float h) {
   const int64_t nc = model.numCloth;
-  const double rate = std::min(1.0, static_cast<double>(h) / model.wetting.rateStep);
-  int anyTransfer = 0;
-  for (int64_t i = 0; i < nc && !anyTransfer; ++i) anyTransfer = s.transfers[i];
-  if (anyTransfer) {
+  const double steps = static_cast<double>(h) / model.wetting.rateStep;
+  const int parts = std::max(1, static_cast<int>(std::ceil(steps - 1e-6)));
+  const double rate = steps / parts;
+  for (int part = 0; part < parts; ++part) {
+    if (part > 0) markTransfers(model, nb, in, s);  // the buffers changed
+    int anyTransfer = 0;
+    for (int64_t i = 0; i < nc && !anyTransfer; ++i) anyTransfer = s.transfers[i];
+    if (!anyTransfer) return;
     outflowScales(model, nb, in, rate, s);
     netFlows(model, nb, in, rate, s);
-  } else {
-    s.delta.assign(static_cast<size_t>(nc), 0.0);
+    parallelFor(nc, [&](int64_t i) { state.clothBuffer[i] = std::max(0.0, state.clothBuffer[i] + s.delta[i]); });
   }
-  parallelFor(nc, [&](int64_t i) { state.clothBuffer[i] = std::max(0.0, state.clothBuffer[i] + s.delta[i]); });
 }
 
 // 4a. the drips still hanging: kept in state.dripId / dripSource and in s.dripOf (the drip of each
