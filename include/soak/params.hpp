@@ -55,21 +55,20 @@ struct WettingParams {
   float saturationEmit = 0.35f;      // S^EW: water above it goes to the emission buffer (section 4.4)
   float saturationMax = 0.4f;        // S^MAX: absorption stops here (Eq. 11)
   float initialSaturation = 0.0f;    // S of every cloth particle at load (Fig. 6 starts saturated)
-  float rateStep = 0.015f;           // s, the step the rates kappa^a, kappa^s and the Eq. 18 transfer refer to
+  float rateStep = 0.015f;           // s, the step the rates kappa^a and the Eq. 18 transfer refer to
   bool everySubstep = false;         // false: the wetting stages run once a step, with the step's dt (Algorithm 1)
   // absorption, Eq. 11
   bool absorption = true;
   float absorptionRate = 0.1f;       // kappa^a per rateStep
   float absorptionGravity = 0.6f;    // eta^a
   float minMassFraction = 0.1f;      // a water particle lighter than this times water.particleMass is absorbed whole
-  // diffusion, Eq. 12-17
+  // diffusion, Eq. 12-17 as a rate in time with a capillary equilibrium (docs/models.md, "Diffusion")
   bool diffusion = true;
-  bool diffusionGravity = true;      // the (1 + eta^d cos theta) factor (Fig. 5c); off gives Fig. 5b
-  float diffusionRate = 0.5f;        // kappa^d
+  bool diffusionGravity = true;      // gravity in the wicking: the equilibrium height H and (1 + eta^d cos theta) (Fig. 5c); off gives Fig. 5b
+  float diffusivity = 0.03f;          // m^2/s, D: Eq. 12's kappa^d as the diffusion coefficient of S
+  float wickingHeight = 0.15f;        // m, H: at capillary equilibrium S halves every H of height
   float diffusionGravityFactor = 0.4f;  // eta^d
-  float smoothing = 0.8f;            // kappa^s per rateStep
-  float epsilon = 1.0e11f;           // (m^2 kg)^-2, epsilon of Eq. 15 (in the units of |grad C|^2)
-  int diffusionIterations = 1;       // projections per wetting pass
+  int diffusionIterations = 1;       // explicit sub-steps per stable one (accuracy only)
   // emission, Eq. 18-19
   bool emission = true;
   float beta = 1.5f;                 // s^2/m, beta of Eq. 18

@@ -191,10 +191,9 @@ void readWetting(ObjectReader r, WettingParams& w) {
   ObjectReader f = r.object("diffusion");
   w.diffusion = f.boolean("enabled", d.diffusion);
   w.diffusionGravity = f.boolean("gravity", d.diffusionGravity);
-  w.diffusionRate = f.number("rate", d.diffusionRate, Range::nonNegative());
+  w.diffusivity = f.number("diffusivity", d.diffusivity, Range::nonNegative());
+  w.wickingHeight = f.number("wickingHeight", d.wickingHeight, Range::positive());
   w.diffusionGravityFactor = f.number("gravityInfluence", d.diffusionGravityFactor, Range::unit());
-  w.smoothing = f.number("smoothing", d.smoothing, Range::unit());
-  w.epsilon = f.number("epsilon", d.epsilon, Range::nonNegative());
   w.diffusionIterations = f.integer("iterations", d.diffusionIterations, Range::atLeast(1));
   f.finish();
   ObjectReader e = r.object("emission");

@@ -52,8 +52,15 @@ struct WettingScratch {
   std::vector<uint8_t> isDrip;     // water particles hanging as drips (not absorbed)
   std::vector<uint8_t> keep;       // 0 for water absorbed whole; compacted by finishWetting
   bool anyAbsorbedWhole = false;
-  std::vector<float> sigma;        // PBD step of each particle's saturation constraint (Eq. 15-17)
   std::vector<double> delta;       // kg, change of held water or buffer of this pass
+  // diffusion (Eq. 12-17 as a rate): per entry of a cloth particle's cloth part, like the pair geometry
+  std::vector<float> diffusionNorm;    // nu of each piece, from the rest shape (computed once a run)
+  std::vector<float> pairConductance;  // kg/s, T_ij = D nu V_i V_j lap W_ij / c (0 for another piece)
+  std::vector<float> pairRise;         // m, z_j - z_i (up against gravity)
+  std::vector<double> pairFlow;        // kg, the water entering i from j in one sub-step
+  std::vector<float> lossRate;         // 1/s, the fastest a particle can lose its water
+  std::vector<double> inScale;         // share of its inflow a particle has room for below S^MAX
+  std::vector<uint8_t> wetPair;        // the particle or a cloth neighbour holds water (else no flow)
   std::vector<uint8_t> transfers;  // Eq. 18 holds for the particle
   std::vector<float> outScale;     // keeps a buffer's outflow within the buffer (Eq. 18)
   std::vector<int64_t> dripOf;     // index of the drip hanging from each cloth particle, -1 when none
@@ -163,24 +170,26 @@ void finishWetting(const Model& model, State& state, WettingScratch& s);
 
 // diffusion.cpp -----------------------------------------------------------------------------------
 
-// Eq. 12-17 as a PBD projection of the saturation field, written as pairwise exchange of held water
-// between neighbouring particles of the same piece so the held total is conserved (NOTES.md)
-void diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
+// Eq. 12-17 as a rate in time with a capillary equilibrium (docs/models.md, "Diffusion"): held water
+// moves between neighbouring particles of the same piece at q_{j->i} = T_ij (1 + eta^d cos)
+// [(S_j - S_i) + lambda S_up (z_j - z_i)], conserved exactly, S_i kept <= S^MAX; over h seconds in
+// explicit sub-steps. Returns the number of sub-steps (0 when nothing is held).
+int diffuseWater(const Model& model, State& state, const NeighborLists& nb, WettingScratch& s, float h);
 
-// the pair terms of diffusion, called by both of its loops and the tests (selects only, for `omp simd`):
-// w_ij = kappa^d lap W_ij / rho0 (1 + eta^d cos) (Eq. 12 with kappa_i^d = kappa_j^d), cos along the
-// flow (the constraint's step takes |cos|)
-inline float diffusionWeight(float kd, float lap, float rho0, float eta, float cosine) {
-  return (kd * lap / rho0) * (1.0f + eta * cosine);
+// the water entering i from j over tau seconds (kg): T_ij (1 + eta^d cos) [(S_j - S_i) + lambda S_up
+// (z_j - z_i)] tau, S_up of the higher particle, cos = cos theta_ij taken along the flow (> 0 going
+// down); rise = z_j - z_i. Exactly minus the value seen from j, so the held total is conserved
+inline double diffusionFlow(double tau, float conductance, float eta, float cosIJ, float si, float sj, float lambda,
+                            float rise) {
+  const double sUp = rise > 0.0f ? sj : si;
+  const double push = (static_cast<double>(sj) - si) + static_cast<double>(lambda) * sUp * rise;
+  const float cosFlow = push > 0.0 ? cosIJ : -cosIJ;
+  return tau * conductance * (1.0 + static_cast<double>(eta * cosFlow)) * push;
 }
-// the water entering i from j in one iteration, kappa^s min(sigma_i, sigma_j) w_ij min(V_i, V_j) / c
-// (S_j - S_i) (kg): Eq. 15-17 as a pairwise exchange (docs/models.md), so i's gain is j's loss exactly
-inline double diffusionExchange(float kappaS, float sigmaI, float sigmaJ, float wij, float vI, float vJ, double c,
-                                double sjMinusSi) {
-  const float minSigma = sigmaJ < sigmaI ? sigmaJ : sigmaI;  // std::min(sigma_i, sigma_j)
-  const float minV = vJ < vI ? vJ : vI;                      // std::min(V_i, V_j)
-  return static_cast<double>(kappaS) * minSigma * wij * minV / c * sjMinusSi;
-}
+
+// explicit sub-steps for a pass of h seconds when no particle may lose water faster than lossRate (1/s):
+// tau lossRate <= 1/2, times iterations (wetting.diffusion.iterations, for accuracy)
+int diffusionSubsteps(float lossRate, float h, int iterations);
 
 // emission.cpp ------------------------------------------------------------------------------------
 

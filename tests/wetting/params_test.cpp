@@ -31,8 +31,8 @@ TEST(WettingParams, DefaultsAreTable1AndASectionTurnsWettingOn) {
   EXPECT_FLOAT_EQ(w.saturationMax, 0.4f);
   EXPECT_FLOAT_EQ(w.massThreshold, 0.002f);
   EXPECT_FLOAT_EQ(w.absorptionRate, 0.1f);
-  EXPECT_FLOAT_EQ(w.diffusionRate, 0.5f);
-  EXPECT_FLOAT_EQ(w.smoothing, 0.8f);
+  EXPECT_FLOAT_EQ(w.diffusivity, WettingParams{}.diffusivity);
+  EXPECT_GT(w.wickingHeight, 0.0f);
   EXPECT_FLOAT_EQ(w.attraction, 10.0f);
   EXPECT_FLOAT_EQ(w.stickingRate, 0.3f);
   EXPECT_FLOAT_EQ(w.absorptionGravity, 0.6f);
@@ -60,9 +60,9 @@ TEST(WettingParams, RefusesInconsistentSaturations) {
 }
 
 TEST(WettingParams, RefusesNegativeRatesAndUnknownKeys) {
-  for (const char* key : {"wetting.absorption.rate", "wetting.diffusion.rate", "wetting.diffusion.smoothing",
+  for (const char* key : {"wetting.absorption.rate", "wetting.diffusion.diffusivity", "wetting.diffusion.wickingHeight",
                           "wetting.emission.beta", "wetting.emission.attraction", "wetting.sticking.rate",
-                          "wetting.sticking.strength", "wetting.diffusion.epsilon"}) {
+                          "wetting.sticking.strength"}) {
     const std::string e = errorOf({std::string(key) + "=-0.1"});
     EXPECT_NE(e.find(std::string("<test>: at ") + key + ": expected a number"), std::string::npos) << e;
     EXPECT_NE(e.find("got -0.1"), std::string::npos) << e;
