@@ -27,8 +27,9 @@ namespace {
 
 constexpr int kMaxDiffusionSubsteps = 4096;  // a guard: D or dt far beyond any scene's
 
-// nu of each piece: 4 / max_i sum_j V_j lap W_ij |x_ij|^2 over the rest shape (the sum a full
-// neighbourhood gives for the field |x - x_i|^2, whose Laplacian on a sheet is 4)
+// nu of each piece: 4 / sum_j V_j lap W_ij |x_ij|^2 on the rest shape at its particle with the most
+// neighbours (an interior one: the sum a full neighbourhood gives for the field |x - x_i|^2, whose
+// Laplacian on a sheet is 4; at an edge the neighbours' larger V_j would inflate it)
 void diffusionNorms(const Model& model, const State& state, WettingScratch& s) {
   if (s.diffusionNorm.size() == model.pieces.size()) return;  // once a run: the rest shape is constant
   const int64_t nc = model.numCloth;
@@ -39,16 +40,19 @@ void diffusionNorms(const Model& model, const State& state, WettingScratch& s) {
   buildGrid(model.clothRestPosition, *std::max_element(radius.begin(), radius.end()), grid);
   buildNeighborLists(model.clothRestPosition, radius, grid, nb);
   std::vector<double> most(model.pieces.size(), 0.0);
+  std::vector<int> mostCount(model.pieces.size(), -1);
   for (int64_t i = 0; i < nc; ++i) {
     const size_t k = clothPiece(state.particles.phase[i]);
     double sum = 0.0;
+    int count = 0;
     for (uint32_t e = nb.start[i]; e < nb.start[i + 1]; ++e) {
       const uint32_t j = nb.index[e];
       if (static_cast<int64_t>(j) >= nc || state.particles.phase[j] != state.particles.phase[i]) continue;
       const float r2 = (model.clothRestPosition[i] - model.clothRestPosition[j]).squaredNorm();
       sum += static_cast<double>(volume[j]) * viscosityLaplacian(std::sqrt(r2), pairRadius(radius[i], radius[j])) * r2;
+      ++count;
     }
-    most[k] = std::max(most[k], sum);
+    if (count > mostCount[k]) most[k] = sum, mostCount[k] = count;
   }
   s.diffusionNorm.resize(model.pieces.size());
   for (size_t k = 0; k < most.size(); ++k) s.diffusionNorm[k] = most[k] > 0.0 ? static_cast<float>(4.0 / most[k]) : 0.0f;
