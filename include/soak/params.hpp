@@ -8,7 +8,8 @@ struct SolverParams {
   float dt = 0.015f;              // s, time step per frame-step (Table 1)
   int substeps = 1;               // substeps per step; dt/substeps is the integration step
   int fluidIterations = 4;        // PBF density iterations per substep
-  int clothIterations = 8;        // cloth constraint iterations per substep
+  int clothSubsteps = 1;          // small steps the PBD cloth takes per substep (Macklin et al. 2019)
+  int clothIterations = 8;        // cloth constraint iterations per small step
   int couplingIterations = 2;     // water-cloth coupling passes per substep (Eq. 21)
   Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2
   Vec3 domainMin{-10.0f, -10.0f, -10.0f};  // m; particles leaving this box are removed and counted

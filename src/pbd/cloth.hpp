@@ -22,6 +22,8 @@ struct ClothScratch {
   std::vector<float> correctionBend;  // m, the same for the bend constraints, 12 per constraint
   std::vector<Vec3> delta;
   std::vector<int> deltaCount;
+  std::vector<Vec3> stepPosition, stepVelocity;  // m, m/s: a cloth particle's at the start of a small step
+  std::vector<Vec3> velocityOffset;  // m/s: the last small step's velocity minus (x* - x)/h (stepCloth)
 };
 
 // C(x1, x2) = |x1 - x2| - l0 (Eq. 8); returns C and writes gradients wrt x1 and x2
@@ -34,6 +36,12 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 // solves the cloth constraints for `iterations` iterations on p.xPred (XPBD, multipliers reset
 // here once per substep)
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations);
+
+// the PBD cloth's substep of h: model.solver.clothSubsteps small steps of h/clothSubsteps, each a
+// prediction from the last (v += h_s g, x* = x + h_s v), the tethers and clothIterations iterations
+// of solveCloth (Macklin et al. 2019: substeps converge faster than iterations). Leaves x* at the
+// last small step's end and scratch.velocityOffset for updateVelocities. Moves only free PBD cloth.
+void stepCloth(const Model& model, Particles& p, ClothScratch& scratch, float h);
 
 // pushes apart cloth particles of the same piece closer than its thickness that are not mesh
 // neighbours (Jacobi, gather style: each particle sums its own corrections)

@@ -35,11 +35,14 @@ void predictPositions(const Model& model, const std::vector<IndexRange>& moved, 
   });
 }
 
-void updateVelocities(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt) {
+void updateVelocities(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt,
+                      std::span<const Vec3> clothVelocityOffset) {
   const int64_t nc = model.numCloth;
+  const int64_t offsets = static_cast<int64_t>(clothVelocityOffset.size());
   const float inv = 1.0f / dt;
   parallelForRanges(moved, [&](int64_t i) {
     Vec3 v = (p.xPred[i] - p.x[i]) * inv;
+    if (i < offsets) v += clothVelocityOffset[i];
     if (i < nc) v *= std::max(0.0f, 1.0f - dt * model.pieces[clothPiece(p.phase[i])].material.damping);
     p.v[i] = v;
   });

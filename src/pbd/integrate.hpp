@@ -7,6 +7,7 @@
 #include "pbd/fluid.hpp"
 #include "world/colliders.hpp"
 
+#include <span>
 #include <vector>
 
 namespace soak {
@@ -18,8 +19,10 @@ void pbdParticles(const Model& model, size_t n, std::vector<IndexRange>& ranges)
 // v += dt g; x* = x + dt v for the particles in `moved`; pinned cloth follows its rest position
 void predictPositions(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt);
 
-// v = (x* - x) / dt for the particles in `moved`, with the cloth's velocity damping
-void updateVelocities(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt);
+// v = (x* - x) / dt for the particles in `moved`, plus cloth particle i's clothVelocityOffset[i] where
+// given (stepCloth's small steps), with the cloth's velocity damping
+void updateVelocities(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt,
+                      std::span<const Vec3> clothVelocityOffset = {});
 
 // x = x*
 void commitPositions(Particles& p);

@@ -96,6 +96,7 @@ void readSolver(ObjectReader r, SolverParams& s) {
   s.dt = r.number("dt", d.dt, Range::positive());
   s.substeps = r.integer("substeps", d.substeps, Range::atLeast(1));
   s.fluidIterations = r.integer("fluidIterations", d.fluidIterations, Range::atLeast(1));
+  s.clothSubsteps = r.integer("clothSubsteps", d.clothSubsteps, Range::atLeast(1));
   s.clothIterations = r.integer("clothIterations", d.clothIterations, Range::atLeast(0));
   s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, Range::atLeast(0));
   s.gravity = r.vec3("gravity", d.gravity);

@@ -5,7 +5,6 @@
 #include "garment/stage.hpp"
 #include "pbd/integrate.hpp"
 #include "sim/diagnostics.hpp"
-#include "pbd/tethers.hpp"
 #include "sim/workspace.hpp"
 #include "world/emitters.hpp"
 
@@ -61,8 +60,7 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
   scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
   solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
   clock.lap(ms.water);
-  solveTethers(model, p);                                                           // long range attachments first,
-  solveCloth(model, p, ws.cloth, h, model.solver.clothIterations);                  // then stretch Eq. 8, bend Eq. 9
+  stepCloth(model, p, ws.cloth, h);                                                 // small steps: tethers, Eq. 8, Eq. 9
   clock.lap(ms.cloth, StagePart::clothSolve);
   clothSelfCollision(model, p, ws.neighbors, ws.cloth);
   clock.lap(ms.cloth, StagePart::clothSelfCollision);
@@ -81,7 +79,7 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
 // v from x* - x, then x = x*
 void updateVelocitiesAndCommit(const Model& model, Workspace& ws, Particles& p, float h, StepStats& stats,
                                StageClock& clock) {
-  updateVelocities(model, ws.pbdParticles, p, h);                                   // v = (x* - x) / dt, damping
+  updateVelocities(model, ws.pbdParticles, p, h, ws.cloth.velocityOffset);          // v = (x* - x) / dt, damping
   addCouplingVelocity(model, p, ws.garment, h);                                     // implicit cloth pushed by water
   applyColliderRestitution(model, ws.poses, ws.contactNormal, p);
   clock.lap(stats.ms.velocities);

@@ -1,0 +1,55 @@
+// the PBD cloth's substep as small steps (Macklin, Storey, Lu, Terdiman, Chentanez, Jeschke, Müller
+// 2019, "Small steps in physics simulation"): the stretch error that a few Gauss-Seidel iterations
+// leave grows with the step squared, so m steps of h/m with one iteration each end far closer to
+// inextensible than one step of h with m iterations, at about the same cost (docs/models.md, Eq. 8)
+#include "core/parallel.hpp"
+#include "pbd/cloth.hpp"
+#include "pbd/tethers.hpp"
+
+namespace soak {
+
+void stepCloth(const Model& model, Particles& p, ClothScratch& scratch, float h) {
+  const int n = model.numCloth;
+  const int steps = std::max(1, model.solver.clothSubsteps);
+  const int iterations = model.solver.clothIterations;
+  scratch.velocityOffset.assign(static_cast<size_t>(std::max(n, 0)), Vec3::Zero());
+  if (steps == 1 || n == 0 || h <= 0.0f) {
+    solveTethers(model, p);  // long range attachments first, the iterations smooth what they moved
+    solveCloth(model, p, scratch, h, iterations);
+    return;
+  }
+  const float hs = h / static_cast<float>(steps);
+  const Vec3 g = model.solver.gravity;
+  const auto moves = [&](int64_t i) { return !model.clothPinned[i] && !model.clothImplicit[i]; };
+  scratch.stepPosition.resize(n);
+  scratch.stepVelocity.resize(n);
+  Vec3* y = scratch.stepPosition.data();
+  Vec3* u = scratch.stepVelocity.data();
+  // the substep's start: x and the velocity before predictPositions added h g
+  parallelFor(n, [&](int64_t i) {
+    y[i] = p.x[i];
+    u[i] = moves(i) ? Vec3(p.v[i] - h * g) : Vec3::Zero();
+  });
+  for (int s = 0; s < steps; ++s) {
+    parallelFor(n, [&](int64_t i) {
+      if (!moves(i)) return;
+      u[i] += hs * g;
+      p.xPred[i] = y[i] + hs * u[i];
+    });
+    solveTethers(model, p);
+    solveCloth(model, p, scratch, hs, iterations);
+    parallelFor(n, [&](int64_t i) {
+      if (!moves(i)) return;
+      u[i] = (p.xPred[i] - y[i]) / hs;
+      y[i] = p.xPred[i];
+    });
+  }
+  // updateVelocities takes v = (x* - x)/h, the mean over the substep; the offset turns it into the last
+  // small step's velocity plus what the later stages (collisions, coupling) add to x*, over h
+  Vec3* offset = scratch.velocityOffset.data();
+  parallelFor(n, [&](int64_t i) {
+    if (moves(i)) offset[i] = u[i] - (p.xPred[i] - p.x[i]) / h;
+  });
+}
+
+}  // namespace soak
