@@ -30,17 +30,20 @@ void stepCloth(const Model& model, Particles& p, ClothScratch& scratch, float h)
     y[i] = p.x[i];
     u[i] = moves(i) ? Vec3(p.v[i] - h * g) : Vec3::Zero();
   });
+  // y holds each small step's prediction: the velocity changes by the constraints' move over h_s, so a
+  // particle they leave alone keeps v + t g exactly (from x* - x, rounding in |x| / h_s would drift)
   for (int s = 0; s < steps; ++s) {
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
       u[i] += hs * g;
       p.xPred[i] = y[i] + hs * u[i];
+      y[i] = p.xPred[i];
     });
     solveTethers(model, p);
     solveCloth(model, p, scratch, hs, iterations);
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
-      u[i] = (p.xPred[i] - y[i]) / hs;
+      u[i] += (p.xPred[i] - y[i]) / hs;
       y[i] = p.xPred[i];
     });
   }
