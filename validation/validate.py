@@ -3,7 +3,7 @@
 compares them with experiments and closed forms, and writes docs/validation.md with its plots in
 docs/validation/. Each case states its target and the measured error.
 
-usage: validation/validate.py [--out DIR] [--only NAME ...]     (about 10 minutes on 2 cores)
+usage: validation/validate.py [--out DIR] [--only NAME ...]     (about 20 minutes on 2 cores)
 """
 import argparse
 import datetime
@@ -16,6 +16,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import case_cloth
+import case_wicking
 import numpy as np
 import soakrun
 
@@ -160,7 +162,18 @@ def save(fig, name):
     return f"validation/{name}"
 
 
-CASES = {"dam_break": dam_break, "rest": rest, "leaks": leaks, "free_fall": free_fall, "budget": budget}
+def hanging_cloth(work):
+    return case_cloth.run(work, save)
+
+
+def wicking(work):
+    return case_wicking.run(work, save)
+
+
+hanging_cloth.__doc__ = case_cloth.__doc__
+wicking.__doc__ = case_wicking.run.__doc__
+CASES = {"dam_break": dam_break, "rest": rest, "leaks": leaks, "free_fall": free_fall, "budget": budget,
+         "hanging_cloth": hanging_cloth, "wicking": wicking}
 
 
 def write_report(results):
