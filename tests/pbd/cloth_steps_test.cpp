@@ -86,15 +86,9 @@ TEST(ClothSteps, FreeSheetFallsWithGravityWhateverTheSmallSteps) {
 
 TEST(ClothSteps, SameStateOnOneTwoAndThreeThreads) {
   // 60 x 60 particles: 2 slabs of the cloth schedule and loops long enough to be split over threads
-  uint64_t hashes[3];
-  for (int threads : {1, 2, 3}) {
-    setThreadCount(threads);
-    Scene scene = sceneFromJson(kHangingSheet, {"cloth.0.mesh.resolution=[60, 60]", "solver.clothSubsteps=4"});
-    ASSERT_EQ(scene.model.stretch.schedule.numSlabs, 2);
-    runSteps(scene, 10);
-    hashes[threads - 1] = stateHash(scene.state);
-  }
-  setThreadCount(2);
+  const auto hashes = hashesOnOneTwoThreeThreads(
+      [] { return sceneFromJson(kHangingSheet, {"cloth.0.mesh.resolution=[60, 60]", "solver.clothSubsteps=4"}); }, 10,
+      [](const Scene& scene) { EXPECT_EQ(scene.model.stretch.schedule.numSlabs, 2); });
   EXPECT_EQ(hashes[0], hashes[1]);
   EXPECT_EQ(hashes[0], hashes[2]);
 }

@@ -40,15 +40,9 @@ TEST(Step, SameStateHashWithOneAndTwoThreads) {
 TEST(Step, SameStateHashOnOneTwoAndThreeThreadsWithClothSlabs) {
   // a 64 x 64 sheet: 2 slabs of the cloth schedule, and enough water and cloth for the chunked
   // neighbour, coupling and cloth loops to spread over 3 threads unevenly
-  uint64_t hashes[3];
-  for (int threads : {1, 2, 3}) {
-    setThreadCount(threads);
-    Scene scene = sceneFromJson(kSmallCubeOnCloth, {"cloth.0.mesh.resolution=[64, 64]"});
-    ASSERT_EQ(scene.model.stretch.schedule.numSlabs, 2);
-    runSteps(scene, 20);
-    hashes[threads - 1] = stateHash(scene.state);
-  }
-  setThreadCount(2);
+  const auto hashes = hashesOnOneTwoThreeThreads(
+      [] { return sceneFromJson(kSmallCubeOnCloth, {"cloth.0.mesh.resolution=[64, 64]"}); }, 20,
+      [](const Scene& scene) { EXPECT_EQ(scene.model.stretch.schedule.numSlabs, 2); });
   EXPECT_EQ(hashes[0], hashes[1]);
   EXPECT_EQ(hashes[0], hashes[2]);
 }

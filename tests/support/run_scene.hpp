@@ -5,6 +5,8 @@
 
 #include "core/parallel.hpp"
 
+#include <array>
+#include <cstdint>
 #include <string>
 
 namespace soak::testing {
@@ -23,6 +25,22 @@ inline StepStats runSteps(Scene& scene, int steps) {
   StepStats total;
   for (int s = 0; s < steps; ++s) step(scene.model, scene.state, *ws, scene.model.solver.dt, total);
   return total;
+}
+
+// the state hash after `steps` steps of the scene that make() loads, on 1, 2 and 3 threads (the thread
+// count is set back to 2); check(scene) runs on each loaded scene first
+template <class Make, class Check>
+std::array<uint64_t, 3> hashesOnOneTwoThreeThreads(Make make, int steps, Check check) {
+  std::array<uint64_t, 3> hashes{};
+  for (int threads : {1, 2, 3}) {
+    setThreadCount(threads);
+    Scene scene = make();
+    check(scene);
+    runSteps(scene, steps);
+    hashes[static_cast<size_t>(threads - 1)] = stateHash(scene.state);
+  }
+  setThreadCount(2);
+  return hashes;
 }
 
 inline double totalWaterMass(const Scene& scene) {
