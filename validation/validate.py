@@ -7,6 +7,7 @@ usage: validation/validate.py [--out DIR] [--only NAME ...]     (about 20 minute
 """
 import argparse
 import datetime
+import inspect
 import os
 import subprocess
 import sys
@@ -191,7 +192,7 @@ def write_report(results):
     lines.append("")
     for name, (rows, plot) in results.items():
         if plot:
-            lines += [f"## {name.replace('_', ' ')}", "", CASES[name].__doc__.strip(), "", f"![{name}]({plot})", ""]
+            lines += [f"## {name.replace('_', ' ')}", "", inspect.cleandoc(CASES[name].__doc__), "", f"![{name}]({plot})", ""]
     with open(os.path.join(DOCS, "validation.md"), "w") as f:
         f.write("\n".join(lines))
 
