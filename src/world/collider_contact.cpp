@@ -121,9 +121,15 @@ ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose
   Vec3 n0;
   const float startDistance = colliderDistance(part.shape, part.pose, from, &n0);
   if (startDistance >= 0.0f) {  // started outside: back on the face the path entered by
-    Vec3 entry = from;            // already within the margin at the start: the face it rests on
-    if (startDistance >= margin && !firstEntry(part, from, xp, margin, &entry)) return r;
-    const float entryDistance = colliderDistance(part.shape, part.pose, entry, &nrm);
+    // within the margin at the start, or too short a path to pass the part's middle: the face nearest
+    // the start; else the face where the path entered the margin
+    Vec3 entry = from;
+    float entryDistance = startDistance;
+    nrm = n0;
+    if (startDistance >= margin && length >= 0.5f * part.thickness) {
+      if (!firstEntry(part, from, xp, margin, &entry)) return r;
+      entryDistance = colliderDistance(part.shape, part.pose, entry, &nrm);
+    }
     d = (xp - entry).dot(nrm) + entryDistance - margin;  // x*'s height over the entry face's tangent plane, less the margin
     if (d >= (repeat ? -1e-6f * margin : 0.0f)) return r;  // grazed the margin and left it again
     r.putBack = rawEnd < 0.0f || d < -(part.thickness + 2.0f * margin);
@@ -133,9 +139,10 @@ ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose
     r.putBack = true;  // found inside: out along the nearest normal
   }
   xp -= d * nrm;
-  if (colliderDistance(part.shape, part.pose, xp, &n0) < margin - 1e-6f) {  // a concave mesh: the nearest face as well
-    xp -= (colliderDistance(part.shape, part.pose, xp, &n0) - margin) * n0;
-  }
+  // still within the margin (a concave mesh, or a box's edge that the start's face did not cover): the
+  // nearest face as well
+  const float after = colliderDistance(part.shape, part.pose, xp, &n0);
+  if (after < margin - 1e-6f) xp -= (after - margin) * n0;
   if (!repeat) {
     const Vec3 slip = (xp - x) - ownerPose.velocityAt(xp) * dt;  // motion relative to the surface
     xp += coulombFriction(slip, nrm, mu, -d) - slip;                // the normal push -d limits the friction
@@ -182,18 +189,21 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
     Vec3 xp = p.xPred[i];
     if (distanceBound[i] >= margin + (xp - p.x[i]).norm() + carried) return;
     // a push out of one part can put x* into another met before it (a container's wall after its
-    // neighbour's): up to three passes, the later ones only pushing out
+    // neighbour's): up to three passes, each later one over the parts before the last that pushed,
+    // only pushing out
     int caught = 0;
-    for (int pass = 0; pass < kContactPasses; ++pass) {
-      bool touched = false;
-      for (const ContactPart& part : parts) {
-        const Collider& owner = model.colliders[part.owner];
+    size_t end = parts.size();
+    for (int pass = 0; pass < kContactPasses && end > 0; ++pass) {
+      size_t lastPush = 0;
+      for (size_t k = 0; k < end; ++k) {
+        const ContactPart& part = parts[k];
         const ContactResult r = contactWith(part, poses[part.owner], p.x[i], xp, margin, dt,
-                                            frictionOf(model, owner, p.phase[i]), pass > 0, &contactNormal[i]);
+                                            frictionOf(model, model.colliders[part.owner], p.phase[i]), pass > 0,
+                                            &contactNormal[i]);
         caught += r.putBack ? 1 : 0;
-        touched = touched || r.touched;
+        if (r.touched) lastPush = k;
       }
-      if (!touched || parts.size() == 1) break;
+      end = lastPush;
     }
     p.xPred[i] = xp;
     if (caught) putBack.fetch_add(1, std::memory_order_relaxed);
