@@ -97,6 +97,7 @@ bool firstEntry(const ContactPart& part, const Vec3& from, const Vec3& to, float
 }
 
 constexpr int kContactPasses = 3;
+constexpr float kRestingBand = 1.01f;  // a start within 1% beyond the margin rests on its nearest face
 
 struct ContactResult {
   bool touched = false;
@@ -121,12 +122,12 @@ ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose
   Vec3 n0;
   const float startDistance = colliderDistance(part.shape, part.pose, from, &n0);
   if (startDistance >= 0.0f) {  // started outside: back on the face the path entered by
-    // within the margin at the start, or too short a path to pass the part's middle: the face nearest
-    // the start; else the face where the path entered the margin
+    // within the margin at the start (or on it, to 1% of it: a particle resting in contact): the face
+    // nearest the start; else the face where the path entered the margin
     Vec3 entry = from;
     float entryDistance = startDistance;
     nrm = n0;
-    if (startDistance >= margin && length >= 0.5f * part.thickness) {
+    if (startDistance >= kRestingBand * margin) {
       if (!firstEntry(part, from, xp, margin, &entry)) return r;
       entryDistance = colliderDistance(part.shape, part.pose, entry, &nrm);
     }
