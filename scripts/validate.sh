@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # the validation suite (validation/validate.py): installs Debian's python3-matplotlib if missing, builds
 # soak (scripts/setup.sh) and runs every case; writes docs/validation.md and docs/validation/*.png.
-# About 5 minutes on 2 cores. Arguments go to validate.py (--only CASE..., --out DIR).
+# About 15 minutes on 2 cores. Arguments go to validate.py (--only CASE..., --out DIR).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! dpkg-query -W -f='${Status}' python3-matplotlib 2>/dev/null | grep -q "install ok installed"; then

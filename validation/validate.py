@@ -183,7 +183,7 @@ def write_report(results):
     lines = ["# Validation", "",
              f"Written by `validation/validate.py` on {datetime.date.today()} at commit {commit} (build/soak, 2 threads).",
              "Each row: the case, its target, what soak measured, and whether it holds. Scenes in `validation/`;",
-             "`./scripts/validate.sh` installs python3-matplotlib, builds soak and rewrites this page (about 5 minutes).",
+             "`./scripts/validate.sh` installs python3-matplotlib, builds soak and rewrites this page (about 15 minutes).",
              "Targets are issue 22's; a row that does not hold is an open problem, listed as such.",
              "", "| case | target | measured | holds |", "|---|---|---|---|"]
     for name, (rows, _) in results.items():
