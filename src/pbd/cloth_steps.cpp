@@ -12,12 +12,13 @@ void stepCloth(const Model& model, Particles& p, ClothScratch& scratch, float h)
   const int n = model.numCloth;
   const int steps = std::max(1, model.solver.clothSubsteps);
   const int iterations = model.solver.clothIterations;
-  scratch.velocityOffset.assign(static_cast<size_t>(std::max(n, 0)), Vec3::Zero());
   if (steps == 1 || n == 0 || h <= 0.0f) {
+    scratch.velocityOffset.clear();  // v = (x* - x)/h as it is
     solveTethers(model, p);  // long range attachments first, the iterations smooth what they moved
     solveCloth(model, p, scratch, h, iterations);
     return;
   }
+  scratch.velocityOffset.assign(static_cast<size_t>(n), Vec3::Zero());
   const float hs = h / static_cast<float>(steps);
   const Vec3 g = model.solver.gravity;
   const auto moves = [&](int64_t i) { return !model.clothPinned[i] && !model.clothImplicit[i]; };

@@ -44,8 +44,7 @@ void clothCapacity(const Model& model, const State& state, WettingScratch& s) {
   const int64_t nc = model.numCloth;
   s.capacity.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
-    const double room = static_cast<double>(w.saturationMax) * s.volume[i] / w.c - state.clothWater[i] -
-                        state.clothBuffer[i];
+    const double room = mostHeldWater(w, s.volume[i]) - state.clothWater[i] - state.clothBuffer[i];
     s.capacity[i] = static_cast<float>(std::max(0.0, room));
   });
 }
@@ -219,9 +218,8 @@ void applyGains(const Model& model, State& state, const WettingScratch& s) {
   const int64_t nc = model.numCloth;
   Particles& p = state.particles;
   const std::vector<uint32_t>& first = s.gainFirst;
-  const double c = model.wetting.c, sMax = model.wetting.saturationMax;
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
-    const double most = sMax * s.volume[i] / c;
+    const double most = mostHeldWater(model.wetting, s.volume[i]);
     for (uint32_t g = first[static_cast<size_t>(i)]; g < first[static_cast<size_t>(i) + 1]; ++g) {
       const double gain = s.gain[s.gainSlot[g]];
       const uint32_t j = s.gainWater[g];

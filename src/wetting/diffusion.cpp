@@ -103,7 +103,6 @@ void pairFlows(const Model& model, const State& state, const NeighborLists& nb, 
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
   const float* const S = state.clothSaturation.data();
-  const double sMax = model.wetting.saturationMax;
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     // a dry particle among dry neighbours exchanges nothing (every push is 0): skip the dry cloth
     bool wet = S[i] > 0.0f;
@@ -118,7 +117,7 @@ void pairFlows(const Model& model, const State& state, const NeighborLists& nb, 
       s.pairFlow[e] = q;
       inflow += q > 0.0 ? q : 0.0;
     }
-    const double room = std::max(0.0, sMax * s.volume[i] / r.c - state.clothWater[i]);
+    const double room = std::max(0.0, mostHeldWater(model.wetting, s.volume[i]) - state.clothWater[i]);
     s.inScale[i] = inflow > room ? room / inflow : 1.0;
   });
 }

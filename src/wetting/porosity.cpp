@@ -155,7 +155,7 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
   const Particles& p = state.particles;
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
-  const double c = model.wetting.c, sMax = model.wetting.saturationMax;
+  const double c = model.wetting.c;
   s.volume.resize(static_cast<size_t>(nc));
   state.clothSaturation.resize(static_cast<size_t>(nc));
   // in the loop of the pair geometry, once i's pairs are done: V_i = 1 / sum_k W_ik (Eq. 10) as
@@ -169,7 +169,7 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
     }
     s.volume[i] = 1.0f / sum;
     // S <= S^MAX: what a squeezed particle (V_i shrank) cannot hold goes to its buffer (docs/models.md)
-    const double most = sMax * s.volume[i] / c;
+    const double most = mostHeldWater(model.wetting, s.volume[i]);
     if (state.clothWater[i] > most) {
       state.clothBuffer[i] += state.clothWater[i] - most;
       state.clothWater[i] = most;

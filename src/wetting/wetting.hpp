@@ -141,6 +141,10 @@ void updateWetMasses(const Model& model, State& state);
 // S_i = c m / V_i (Eq. 10) of one cloth particle: the one expression every stage that changes the held
 // water uses, so S_i is bit for bit the same wherever it is updated
 inline float saturationOf(double c, double heldWater, float volume) { return static_cast<float>(c * heldWater / volume); }
+// the most water a cloth particle of volume V_i holds, S^MAX V_i / c (Eq. 10 at S = S^MAX)
+inline double mostHeldWater(const WettingParams& w, float volume) {
+  return static_cast<double>(w.saturationMax) * volume / w.c;
+}
 
 // S_i = c m / V_i for the held water of every cloth particle
 void computeSaturation(const Model& model, const State& state, const WettingScratch& s, std::vector<float>& sat);

@@ -181,12 +181,16 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
   for (size_t c = 0; c < numColliders; ++c)
     colliderDistanceBounds(model.colliders[c], poses[c], p.xPred[0].data(), n, distanceBound.data());
   const std::vector<ContactPart> parts = contactParts(model, poses, numColliders);
+  const bool anyMoves = std::any_of(poses.begin(), poses.begin() + numColliders, [](const ColliderPose& pose) {
+    return !pose.linearVelocity.isZero() || !pose.angularVelocity.isZero();
+  });
   std::atomic<uint64_t> putBack{0};
   parallelForRanges(moved, [&](int64_t i) {
     if (!(p.invMass[i] > 0.0f)) return;
     const float margin = contactMargin(model, p.phase[i]);
     float carried = 0.0f;  // how far the colliders carry the start in this substep
-    for (size_t c = 0; c < numColliders; ++c) carried = std::max(carried, poses[c].velocityAt(p.x[i]).norm() * dt);
+    for (size_t c = 0; anyMoves && c < numColliders; ++c)
+      carried = std::max(carried, poses[c].velocityAt(p.x[i]).norm() * dt);
     Vec3 xp = p.xPred[i];
     if (distanceBound[i] >= margin + (xp - p.x[i]).norm() + carried) return;
     // a push out of one part can put x* into another met before it (a container's wall after its
