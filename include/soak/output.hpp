@@ -33,6 +33,8 @@ struct FrameStats {
   uint64_t removedParticles = 0;
   uint64_t colliderPutBack = 0;
   double densityRatioSum = 0.0;
+  uint64_t fluidIterations = 0;      // summed over the substeps
+  int fluidIterationsMax = 0;
   float maxSpeed = 0.0f;             // m/s
   GarmentStats garment;
 

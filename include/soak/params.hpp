@@ -7,7 +7,9 @@ namespace soak {
 struct SolverParams {
   float dt = 0.015f;              // s, time step per frame-step (Table 1)
   int substeps = 1;               // substeps per step; dt/substeps is the integration step
-  int fluidIterations = 4;        // PBF density iterations per substep
+  int fluidIterations = 4;        // PBF density iterations per substep, at least
+  int fluidMaxIterations = 32;    // at most: more than fluidIterations while the water's mean compression exceeds fluidTolerance
+  float fluidTolerance = 0.01f;   // mean over the water of max(rho_i / rho_0 - 1, 0) the extra iterations stop at
   int clothSubsteps = 1;          // small steps the PBD cloth takes per substep (Macklin et al. 2019)
   int clothIterations = 8;        // cloth constraint iterations per small step
   int couplingIterations = 2;     // water-cloth coupling passes per substep (Eq. 21)

@@ -59,6 +59,8 @@ struct StepStats {
   uint64_t removedParticles = 0;    // water particles that left the domain this step
   uint64_t colliderPutBack = 0;     // particles put back out of a collider they were in or went through
   float meanDensityRatio = 0.0f;    // mean rho_i / rho_0 over water particles after the solve
+  uint64_t fluidIterations = 0;     // PBF iterations, summed over the substeps
+  int fluidIterationsMax = 0;       // the most one substep took
   float maxSpeed = 0.0f;            // m/s over all particles
   GarmentStats garment;
 };

@@ -16,6 +16,8 @@ void FrameStats::add(const StepStats& s) {
   removedParticles += s.removedParticles;
   colliderPutBack += s.colliderPutBack;
   densityRatioSum += s.meanDensityRatio;
+  fluidIterations += s.fluidIterations;
+  fluidIterationsMax = std::max(fluidIterationsMax, s.fluidIterationsMax);
   maxSpeed = std::max(maxSpeed, s.maxSpeed);
   garment += s.garment;
 }
@@ -96,6 +98,8 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
     j["meanDensityRatio"] = fs.densityRatioSum / fs.steps;
   else
     j["meanDensityRatio"] = nullptr;
+  if (fs.substeps > 0)
+    j["fluidIterations"] = {{"mean", static_cast<double>(fs.fluidIterations) / fs.substeps}, {"max", fs.fluidIterationsMax}};
   j["maxSpeed"] = fs.steps > 0 ? fs.maxSpeed : stateMaxSpeed(state);
   j["ms"] = stageJson(fs.ms);
   j["msParts"] = stagePartsJson(fs.ms);

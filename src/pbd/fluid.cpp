@@ -242,13 +242,22 @@ void reactionPass(const Solve& c) {
 
 // The solver's neighbour sums are in pbd/fluid_sums.hpp (vectorised where the build has the wide lane
 // type); the velocity pass below is scalar (once a substep).
-void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
-                FluidScratch& s, int iterations) {
+double meanCompression(const Model& model, const FluidScratch& s) {
+  const size_t nc = static_cast<size_t>(model.numCloth), n = s.density.size();
+  if (n <= nc) return 0.0;
+  const float rho0 = model.water.restDensity;
+  double sum = 0.0;
+  for (size_t i = nc; i < n; ++i) sum += std::max(s.density[i] / rho0 - 1.0f, 0.0f);
+  return sum / static_cast<double>(n - nc);
+}
+
+int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
+               FluidScratch& s, int iterations, int maxIterations) {
   const WaterParams& wp = model.water;
   const size_t n = p.size();
   const int64_t nc = model.numCloth;
   const int64_t nw = static_cast<int64_t>(n) - nc;
-  if (nw <= 0) return;
+  if (nw <= 0) return 0;
   prepareSolve(model, poses, p, s);
   const float sCorrK = wp.tensileK * s.sCorrScale;
   float hU = 0.0f;
@@ -265,10 +274,16 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
   const bool tensile = sCorrK != 0.0f;  // s_corr is 0 without artificial pressure
   attachPairCache(nb, static_cast<size_t>(nc), tensile, s, in);
   const Solve c{model, p, nb, s, in, s.mixedRadius.data(), s.plain.data(), hU, WallKernel(hU), nc, nw};
+  // a Jacobi iteration's correction reaches about h further into the water: a deep pool needs more
+  // of them to carry its weight than a splash (the lambda pass measures the densities first)
+  const int most = std::max(iterations, maxIterations);
+  const double tolerance = model.solver.fluidTolerance;
+  int taken = 0;
   withFlags(uniform, tensile, [&](auto uniform, auto tensile) {
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
-    for (int it = 0; it < iterations; ++it) {
+    for (; taken < most; ++taken) {
       lambdaPass<U>(c);
+      if (taken >= iterations && meanCompression(model, s) <= tolerance) break;
       correctionPass<U, Tensile>(c);
       reactionPass<U>(c);
       parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
@@ -276,6 +291,7 @@ void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Part
       });
     }
   });
+  return taken;
 }
 namespace {
 

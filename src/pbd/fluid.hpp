@@ -38,10 +38,14 @@ struct FluidScratch {
 // its boundary mass Psi_b = rho0 V_b, for the cloth particles with water in their lists (0 elsewhere)
 void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLists& nb, FluidScratch& s);
 
-// the PBF density constraint (Eq. 6-7), `iterations` Jacobi iterations on p.xPred; cloth particles
-// are moved by the boundary reaction (two-way coupling)
-void solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
-                FluidScratch& s, int iterations);
+// the PBF density constraint (Eq. 6-7), Jacobi iterations on p.xPred: `iterations`, then more up to
+// maxIterations (<= iterations: none) while the water's meanCompression exceeds solver.fluidTolerance.
+// Cloth particles are moved by the boundary reaction (two-way coupling). Returns the iterations taken
+int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
+               FluidScratch& s, int iterations, int maxIterations = 0);
+
+// mean over the water particles of max(rho_i / rho_0 - 1, 0), from the densities of the last lambda pass
+double meanCompression(const Model& model, const FluidScratch& s);
 
 // XSPH viscosity and vorticity confinement on water velocities (after v = (x* - x)/dt).
 // listsOfSolve: nb are the lists solveFluid last ran on with s, and no radius has changed since, so its

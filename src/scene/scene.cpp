@@ -96,6 +96,9 @@ void readSolver(ObjectReader r, SolverParams& s) {
   s.dt = r.number("dt", d.dt, Range::positive());
   s.substeps = r.integer("substeps", d.substeps, Range::atLeast(1));
   s.fluidIterations = r.integer("fluidIterations", d.fluidIterations, Range::atLeast(1));
+  s.fluidMaxIterations = r.integer("fluidMaxIterations", std::max(d.fluidMaxIterations, s.fluidIterations),
+                                   Range::atLeast(s.fluidIterations));
+  s.fluidTolerance = r.number("fluidTolerance", d.fluidTolerance, Range::positive());
   s.clothSubsteps = r.integer("clothSubsteps", d.clothSubsteps, Range::atLeast(1));
   s.clothIterations = r.integer("clothIterations", d.clothIterations, Range::atLeast(0));
   s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, Range::atLeast(0));

@@ -58,7 +58,10 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
   clock.lap(ms.neighbors, StagePart::neighborsLists);
   computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
   scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
-  solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations);  // PBF, Eq. 6-7
+  const int its = solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations,
+                             model.solver.fluidMaxIterations);                      // PBF, Eq. 6-7
+  stats.fluidIterations += static_cast<uint64_t>(its);
+  stats.fluidIterationsMax = std::max(stats.fluidIterationsMax, its);
   clock.lap(ms.water);
   stepCloth(model, p, ws.cloth, h);                                                 // small steps: tethers, Eq. 8, Eq. 9
   clock.lap(ms.cloth, StagePart::clothSolve);
