@@ -73,10 +73,15 @@ def dam_break(work):
 
 
 def rest(work):
-    """a settled block: kinetic energy below 1e-3 J per 10k particles within 3 s, density within 1% of 1"""
+    """a settled block: kinetic energy below 1e-3 J per 10k particles within 3 s, density within 1% of 1.
+    The density solve stops at a 1% mean compression (solver.fluidTolerance); what kinetic energy it
+    leaves is the noise of the unconverged Jacobi corrections spread through the block (0.01 - 0.05 J
+    at any iteration count or tolerance tried; 0.24 J at 4 fixed iterations)."""
     out = soakrun.run(os.path.join(HERE, "rest_block.json"), os.path.join(work, "rest"))
-    t, ke, rho = [], [], []
+    t, ke, rho, its = [], [], [], []
     for s, w in water_frames(out):
+        if "fluidIterations" in s:  # not in frame 0's line
+            its.append(s["fluidIterations"]["mean"])
         t.append(s["time"])
         ke.append(kinetic(w) * 1e4 / len(w))
         rho.append(s["meanDensityRatio"])
@@ -91,7 +96,9 @@ def rest(work):
     ax[1].legend()
     at3 = ke[int(np.searchsorted(t, 3.0 - 1e-6))]
     return [("rest: kinetic energy at 3 s", "< 1e-3 J per 10k particles", f"{at3:.3g} J", at3 < 1e-3),
-            ("rest: mean density ratio", "within 1% of 1", f"{rho[-1]:.4f}", abs(rho[-1] - 1) <= 0.01)], \
+            ("rest: mean density ratio", "within 1% of 1", f"{rho[-1]:.4f}", abs(rho[-1] - 1) <= 0.01),
+            ("rest: PBF iterations a substep (the cost)", "at most solver.fluidMaxIterations (32)",
+             f"{np.mean(its[len(its) // 2:]):.1f}", max(its) <= 32)], \
         save(fig, "rest.png")
 
 
