@@ -283,7 +283,7 @@ int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Parti
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (; taken < most; ++taken) {
       lambdaPass<U>(c);
-      if (taken >= iterations && meanCompression(model, s) <= tolerance) break;
+      if (taken >= iterations && stopIterating(meanCompression(model, s), tolerance, taken, s.lastIterations)) break;
       correctionPass<U, Tensile>(c);
       reactionPass<U>(c);
       parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
@@ -291,6 +291,7 @@ int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Parti
       });
     }
   });
+  s.lastIterations = taken;
   return taken;
 }
 namespace {

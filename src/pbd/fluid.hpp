@@ -21,6 +21,7 @@ struct FluidScratch {
   std::vector<float> vorticityNorm; // 1/s, |omega_i| (0 for cloth)
   std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
+  int lastIterations = 0;          // the iterations the last solve took (stopIterating's hysteresis)
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
   std::vector<float> wallClear;    // m, per water particle: a lower bound of its distance to the nearest part at wallFrom
   std::vector<uint8_t> mixedRadius;  // 1: a pair of the particle's list has another radius than water.supportRadius
@@ -43,6 +44,14 @@ void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLi
 // Cloth particles are moved by the boundary reaction (two-way coupling). Returns the iterations taken
 int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
                FluidScratch& s, int iterations, int maxIterations = 0);
+
+// whether the solve stops after `taken` iterations at this mean compression. Hysteresis: it stops
+// below the last solve's count only while the compression is under half the tolerance, so a pool at
+// rest keeps one count; a count that switched from substep to substep would jolt the whole pool by one
+// iteration's correction each time it changed
+inline bool stopIterating(double compression, double tolerance, int taken, int last) {
+  return compression <= (taken < last ? 0.5 * tolerance : tolerance);
+}
 
 // mean over the water particles of max(rho_i / rho_0 - 1, 0), from the densities of the last lambda pass
 double meanCompression(const Model& model, const FluidScratch& s);
