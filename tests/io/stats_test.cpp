@@ -32,6 +32,8 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   a.ms.total = 4.0;
   a.couplingContacts = 10;
   a.meanDensityRatio = 0.9f;
+  a.fluidIterations = 8;  // 4 and 4
+  a.fluidIterationsMax = 4;
   a.maxSpeed = 2.0f;
   a.removedParticles = 1;
   b.substeps = 2;
@@ -41,6 +43,8 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   b.ms.total = 2.0;
   b.couplingContacts = 5;
   b.meanDensityRatio = 1.1f;
+  b.fluidIterations = 20;  // 4 and 16
+  b.fluidIterationsMax = 16;
   b.maxSpeed = 3.0f;
   b.removedParticles = 2;
   fs.add(a);
@@ -58,6 +62,8 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   EXPECT_EQ(j["removedAtBounds"]["total"], 3);
   EXPECT_NEAR(j["meanDensityRatio"].get<double>(), 1.0, 1e-6);
   EXPECT_FLOAT_EQ(j["maxSpeed"].get<float>(), 3.0f);
+  EXPECT_DOUBLE_EQ(j["fluidIterations"]["mean"].get<double>(), 7.0);  // 28 over 4 substeps
+  EXPECT_EQ(j["fluidIterations"]["max"], 16);
   EXPECT_DOUBLE_EQ(j["ms"]["neighbors"].get<double>(), 1.5);
   EXPECT_DOUBLE_EQ(j["ms"]["total"].get<double>(), 6.0);
   EXPECT_DOUBLE_EQ(j["msPerStep"].get<double>(), 3.0);
@@ -78,6 +84,7 @@ TEST(IoStats, FrameLineSumsStepsAndAccountsWater) {
   // frame 0: no steps, max speed measured on the state, no density ratio yet
   const auto j0 = frameStatsJson(f.model, f.state, 0, FrameStats{});
   EXPECT_TRUE(j0["meanDensityRatio"].is_null());
+  EXPECT_FALSE(j0.contains("fluidIterations"));
   // the fastest particle is water particle 4 with v = (0, -1.2, 1.5)
   EXPECT_NEAR(j0["maxSpeed"].get<double>(), std::sqrt(1.2 * 1.2 + 1.5 * 1.5), 1e-5);
   EXPECT_EQ(j0["msPerStep"], 0.0);
