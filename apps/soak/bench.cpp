@@ -240,6 +240,7 @@ json runOne(const BenchJob& job, int threads, bool quiet) {
             {"particles", {{"water", water}, {"cloth", model.numCloth}, {"total", particles}}},
             {"iterations",
              {{"fluid", model.solver.fluidIterations},
+              {"fluidMax", model.solver.fluidMaxIterations},
               {"cloth", model.solver.clothIterations},
               {"coupling", model.solver.couplingIterations},
               {"substeps", model.solver.substeps}}},

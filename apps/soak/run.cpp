@@ -270,8 +270,13 @@ int validateCommand(const ValidateOptions& o) {
                   static_cast<double>(e.end));
   }
   std::printf("  dt:          %g s, %d substeps\n", static_cast<double>(s.dt), s.substeps);
-  std::printf("  iterations:  fluid %d, cloth %d, coupling %d\n", s.fluidIterations, s.clothIterations,
-              s.couplingIterations);
+  if (s.fluidMaxIterations > s.fluidIterations)
+    std::printf("  iterations:  fluid %d (up to %d to a %g mean compression), cloth %d, coupling %d\n",
+                s.fluidIterations, s.fluidMaxIterations, static_cast<double>(s.fluidTolerance), s.clothIterations,
+                s.couplingIterations);
+  else
+    std::printf("  iterations:  fluid %d, cloth %d, coupling %d\n", s.fluidIterations, s.clothIterations,
+                s.couplingIterations);
   if (m.wetting.enabled)
     std::printf("  wetting:     Shao 2017, %s\n", m.wetting.everySubstep ? "after every substep" : "once a step (Algorithm 1)");
   std::printf("  output:      %d frames of %d steps (%g s simulated)\n", scene.output.frames,
