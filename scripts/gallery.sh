@@ -116,7 +116,7 @@ mkdir -p "$work/render"
 still_fig1() { still fig1_jet 100 --camera 2.3,1.9,3.3 --look-at 0,1.05,0; }
 still_fig3a() { still fig3a_cube_on_cloth 100 --camera 1.9,2.0,2.4 --look-at 0,0.75,0; }
 still_fig3b() { still fig3b_cube_on_cloth_wet 40 --camera 1.9,2.5,2.6 --look-at 0,0.7,0; }
-still_fig4() { still fig4_absorption 16 --camera 0.3,0.32,0.75 --look-at 0,0.14,0; }
+still_fig4() { still fig4_absorption 12 --camera 0.3,0.32,0.75 --look-at 0,0.14,0; }
 still_fig5() {
   local f=100 cam=(--camera 1.0,1.4,3.0 --look-at 0,0.72,0)
   run fig5b_dip_no_gravity $f
