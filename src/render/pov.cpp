@@ -1,6 +1,8 @@
 // POV-Ray scene text of one frame (docs/rendering.md)
 #include "render/pov.hpp"
 
+#include "wetting/wetting.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -249,12 +251,6 @@ CameraSpec frameCamera(const Bounds& bounds, const CameraRequest& request, int w
   CameraFit fit(request, width, height);
   fit.add(bounds);
   return fit.camera();
-}
-
-Vec3 rampColor(const std::string& ramp, float saturation, float saturationMax) {
-  const Vec3 dry = ramp == "green" ? Vec3(0.0f, 1.0f, 0.0f) : Vec3(1.0f, 0.0f, 0.0f);
-  const float t = saturationMax > 0.0f ? std::clamp(saturation / saturationMax, 0.0f, 1.0f) : 0.0f;
-  return (1.0f - t) * dry;
 }
 
 std::vector<Vec3> clothColors(const ClothFrame& cloth, const std::string& ramp, float saturationMax) {

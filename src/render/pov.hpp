@@ -69,12 +69,8 @@ struct PovFrameInput {
   std::string title;            // a comment line
 };
 
-// the saturation ramp of the paper: dry colour (red Fig. 3, green Fig. 4) to black at S^MAX, linear in
-// S / S^MAX. Cloth colours are display (sRGB) values, given to POV-Ray as `srgb`, so the picture's
-// shade follows the ramp as the paper's figures show it (and as an OBJ viewer shows the run's colours).
-Vec3 rampColor(const std::string& ramp, float saturation, float saturationMax);
-
-// the colours of the cloth's vertices: from its saturation with the ramp when the frame has one,
+// the colours of the cloth's vertices: from its saturation with the ramp when the frame has one
+// (rampColor, wetting.hpp: the paper's dry colour to black at S^MAX, display values given as `srgb`),
 // else the OBJ's colours, else empty (plain fabric)
 std::vector<Vec3> clothColors(const ClothFrame& cloth, const std::string& ramp, float saturationMax);
 

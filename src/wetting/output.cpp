@@ -12,20 +12,16 @@ std::vector<Vec3> saturationColors(const Model& model, const State& state, const
   return rampColors(state.clothSaturation, model.wetting.saturationMax, ramp);
 }
 
+Vec3 rampColor(const std::string& ramp, float value, float valueMax) {
+  const Vec3 dry = ramp == "green" ? Vec3(0.0f, 1.0f, 0.0f) : Vec3(1.0f, 0.0f, 0.0f);
+  const float t = valueMax > 0.0f ? std::clamp(value / valueMax, 0.0f, 1.0f) : 0.0f;
+  return (1.0f - t) * dry;
+}
+
 std::vector<Vec3> rampColors(const std::vector<float>& value, float valueMax, const std::string& ramp) {
-  const size_t nc = value.size();
-  Vec3 dry;
-  if (ramp == "red")
-    dry = Vec3(1.0f, 0.0f, 0.0f);
-  else if (ramp == "green")
-    dry = Vec3(0.0f, 1.0f, 0.0f);
-  else
-    return {};
-  std::vector<Vec3> colors(nc);
-  for (size_t i = 0; i < nc; ++i) {
-    const float t = valueMax > 0.0f ? std::clamp(value[i] / valueMax, 0.0f, 1.0f) : 0.0f;
-    colors[i] = (1.0f - t) * dry;
-  }
+  if (ramp != "red" && ramp != "green") return {};
+  std::vector<Vec3> colors(value.size());
+  for (size_t i = 0; i < value.size(); ++i) colors[i] = rampColor(ramp, value[i], valueMax);
   return colors;
 }
 

@@ -245,5 +245,8 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
 std::vector<Vec3> saturationColors(const Model& model, const State& state, const std::string& ramp);
 // the same ramp for any per-vertex value: valueMax is drawn black (fully wet), 0 in the ramp's colour
 std::vector<Vec3> rampColors(const std::vector<float>& value, float valueMax, const std::string& ramp);
+// one value of the ramp, linear in value / valueMax (clamped to [0, 1]); a ramp other than "green" is red.
+// Display (sRGB) values: POV-Ray is given them as `srgb`, an OBJ viewer shows them as they are
+Vec3 rampColor(const std::string& ramp, float value, float valueMax);
 
 }  // namespace soak

@@ -2,6 +2,7 @@
 // camera is kept, colliders are drawn at their pose, the cloth as a mesh2 with a texture or normal per
 // vertex, the water as spheres or a surface, and the paper's saturation ramps. Text only: no POV-Ray
 #include "render/pov.hpp"
+#include "wetting/wetting.hpp"
 
 #include <soak/scene.hpp>
 
