@@ -155,6 +155,9 @@ TEST(SceneErrors, WrongTypeAndOutOfRange) {
   EXPECT_HAS(errorWith("cloth.0.material.friction=-0.5"), "at cloth[0].material.friction: expected a number >= 0, got -0.5");
   EXPECT_HAS(errorWith("cloth.0.mesh.resolution=[1, 3]"), "at cloth[0].mesh.resolution[0]: expected an integer >= 2, got 1");
   EXPECT_HAS(errorWith("solver.fluidIterations=0"), "at solver.fluidIterations: expected an integer >= 1, got 0");
+  // the most iterations cannot be fewer than the least (4 by default)
+  EXPECT_HAS(errorWith("solver.fluidMaxIterations=3"), "at solver.fluidMaxIterations: expected an integer >= 4, got 3");
+  EXPECT_HAS(errorWith("solver.fluidTolerance=0"), "at solver.fluidTolerance: expected a number > 0, got 0");
   EXPECT_HAS(errorWith("solver.clothIterations=-1"), "at solver.clothIterations: expected an integer >= 0, got -1");
   EXPECT_HAS(errorWith("cloth.0.material.tetherSlack=-0.1"), "at cloth[0].material.tetherSlack: expected a number >= 0");
   EXPECT_HAS(errorWith("output.water=1"), "at output.water: expected true or false, got 1");
