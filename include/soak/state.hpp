@@ -68,6 +68,9 @@ struct State {
   // Chen 2012 saturation mass and wet friction: the time each cloth particle first got wet
   // (+infinity: dry); one entry per cloth particle when a piece has wetByContact, else empty
   std::vector<float> clothWetStart;
+  // PBF iterations the last substep took: the iterations to solver.fluidTolerance go below it only
+  // with a margin (stopIterating, docs/models.md "Eq. 6-7 iterated to a tolerance")
+  int fluidIterations = 0;
 };
 
 }  // namespace soak

@@ -25,7 +25,8 @@ void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& 
 std::string checkState(const Model& model, const State& state);
 
 // 64-bit FNV-1a hash of every array and counter of the State (particles, ledger, emitters, the
-// cloth's held water, buffers, saturation, drips and wet start times): equal states hash equal
+// cloth's held water, buffers, saturation, drips and wet start times, the last PBF iteration count):
+// equal states hash equal
 uint64_t stateHash(const State& state);
 
 }  // namespace soak

@@ -252,7 +252,7 @@ double meanCompression(const Model& model, const FluidScratch& s) {
 }
 
 int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
-               FluidScratch& s, int iterations, int maxIterations) {
+               FluidScratch& s, int iterations, int maxIterations, int last) {
   const WaterParams& wp = model.water;
   const size_t n = p.size();
   const int64_t nc = model.numCloth;
@@ -283,7 +283,7 @@ int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Parti
     constexpr bool U = decltype(uniform)::value, Tensile = decltype(tensile)::value;
     for (; taken < most; ++taken) {
       lambdaPass<U>(c);
-      if (taken >= iterations && stopIterating(meanCompression(model, s), tolerance, taken, s.lastIterations)) break;
+      if (taken >= iterations && stopIterating(meanCompression(model, s), tolerance, taken, last)) break;
       correctionPass<U, Tensile>(c);
       reactionPass<U>(c);
       parallelFor(static_cast<int64_t>(n), [&](int64_t i) {
@@ -291,7 +291,6 @@ int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Parti
       });
     }
   });
-  s.lastIterations = taken;
   return taken;
 }
 namespace {

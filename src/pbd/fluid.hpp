@@ -21,7 +21,6 @@ struct FluidScratch {
   std::vector<float> vorticityNorm; // 1/s, |omega_i| (0 for cloth)
   std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
-  int lastIterations = 0;          // the iterations the last solve took (stopIterating's hysteresis)
   std::vector<BoundaryPart> parts; // convex collider parts at this substep's poses
   std::vector<float> wallClear;    // m, per water particle: a lower bound of its distance to the nearest part at wallFrom
   std::vector<uint8_t> mixedRadius;  // 1: a pair of the particle's list has another radius than water.supportRadius
@@ -40,10 +39,11 @@ struct FluidScratch {
 void computeBoundaryPsi(const Model& model, const Particles& p, const NeighborLists& nb, FluidScratch& s);
 
 // the PBF density constraint (Eq. 6-7), Jacobi iterations on p.xPred: `iterations`, then more up to
-// maxIterations (<= iterations: none) while the water's meanCompression exceeds solver.fluidTolerance.
-// Cloth particles are moved by the boundary reaction (two-way coupling). Returns the iterations taken
+// maxIterations (<= iterations: none) while the water's meanCompression exceeds solver.fluidTolerance;
+// last: the count of the previous solve (State::fluidIterations, for stopIterating). Cloth particles
+// are moved by the boundary reaction (two-way coupling). Returns the iterations taken
 int solveFluid(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, const NeighborLists& nb,
-               FluidScratch& s, int iterations, int maxIterations = 0);
+               FluidScratch& s, int iterations, int maxIterations = 0, int last = 0);
 
 // whether the solve stops after `taken` iterations at this mean compression. Hysteresis: it stops
 // below the last solve's count only while the compression is under half the tolerance, so a pool at

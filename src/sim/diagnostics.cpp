@@ -60,7 +60,7 @@ uint64_t stateHash(const State& state) {
   const WaterLedger& w = state.ledger;
   hashValues(h, {w.emitted, w.removedAtBounds, w.heldInCloth, w.inBuffers, w.takenByCloth});
   hashValues(h, {w.particlesRemovedAtBounds, w.particlesAbsorbed, w.dripsEmitted, w.particlesTakenByCloth,
-                 state.stepCount, uint64_t{state.nextId}});
+                 state.stepCount, uint64_t{state.nextId}, static_cast<uint64_t>(state.fluidIterations)});
   hashValues(h, {state.time});
   for (const EmitterState& e : state.emitters) {
     hashValues(h, {e.emittedLength});

@@ -59,7 +59,8 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
   computeBoundaryPsi(model, p, ws.neighbors, ws.fluid);                              // cloth as Akinci boundary
   scaleBoundaryByPermeability(model, state, ws.fluid.psi);                          // Eq. 22: wet cloth, thinner wall
   const int its = solveFluid(model, ws.poses, p, ws.neighbors, ws.fluid, model.solver.fluidIterations,
-                             model.solver.fluidMaxIterations);                      // PBF, Eq. 6-7
+                             model.solver.fluidMaxIterations, state.fluidIterations);  // PBF, Eq. 6-7
+  if (its > 0) state.fluidIterations = its;                                         // no water: keep the count
   stats.fluidIterations += static_cast<uint64_t>(its);
   stats.fluidIterationsMax = std::max(stats.fluidIterationsMax, its);
   clock.lap(ms.water);

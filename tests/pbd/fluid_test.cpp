@@ -99,10 +99,8 @@ TEST(Fluid, IteratesUntilTheMeanCompressionIsWithinTolerance) {
   const auto settle = [](const std::string& most, double& compression) {
     Scene scene = sceneFromJson(kColumn, {"solver.substeps=1", "solver.fluidIterations=4",
                                           "solver.fluidMaxIterations=" + most, "solver.fluidTolerance=0.01"});
-    WorkspacePtr ws = makeWorkspace();  // one for the run: it carries the last solve's count
-    StepStats settling, last;
-    for (int k = 0; k < 60; ++k) step(scene.model, scene.state, *ws, scene.model.solver.dt, settling);  // 0.9 s
-    for (int k = 0; k < 10; ++k) step(scene.model, scene.state, *ws, scene.model.solver.dt, last);
+    runSteps(scene, 60);  // 0.9 s: settled
+    const StepStats last = runSteps(scene, 10);  // the last solve's count is in the State
     // the mean compression of the interior (a kernel away from the walls, floor and surface)
     const std::vector<float> rho = densities(scene);
     compression = 0.0;
