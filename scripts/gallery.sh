@@ -113,33 +113,32 @@ still() {
 
 mkdir -p "$work/render"
 
+# side_by_side LEFT RIGHT FRAME LEFT_LABEL RIGHT_LABEL NAME [render options...]: both scenes at FRAME
+# into docs/gallery/NAME.png, and each half alone as docs/gallery/SCENE.png (README.md shows 9(a))
+side_by_side() {
+  local left="$1" right="$2" frame="$3" leftLabel="$4" rightLabel="$5" name="$6"
+  shift 6
+  for scene in "$left" "$right"; do
+    run "$scene" "$frame"
+    render "$scene" "$frame" "$work/render/$scene.png" "$@"
+    palette "$work/render/$scene.png" "$scene"
+  done
+  pair "$work/render/$left.png" "$leftLabel" "$work/render/$right.png" "$rightLabel" "$name"
+}
+
 still_fig1() { still fig1_jet 100 --camera 2.3,1.9,3.3 --look-at 0,1.05,0; }
 still_fig3a() { still fig3a_cube_on_cloth 100 --camera 1.9,2.0,2.4 --look-at 0,0.75,0; }
 still_fig3b() { still fig3b_cube_on_cloth_wet 40 --camera 1.9,2.5,2.6 --look-at 0,0.7,0; }
 still_fig4() { still fig4_absorption 12 --camera 0.3,0.32,0.75 --look-at 0,0.14,0; }
 still_fig5() {
-  local f=100 cam=(--camera 1.0,1.4,3.0 --look-at 0,0.72,0)
-  run fig5b_dip_no_gravity $f
-  run fig5c_dip_gravity $f
-  render fig5b_dip_no_gravity $f "$work/render/fig5b.png" "${cam[@]}"
-  render fig5c_dip_gravity $f "$work/render/fig5c.png" "${cam[@]}"
-  pair "$work/render/fig5b.png" "5(b) no gravity term, t = 3 s" \
-       "$work/render/fig5c.png" "5(c) gravity term, t = 3 s" fig5_dip
-  palette "$work/render/fig5b.png" fig5b_dip_no_gravity  # each half alone as well
-  palette "$work/render/fig5c.png" fig5c_dip_gravity
+  side_by_side fig5b_dip_no_gravity fig5c_dip_gravity 100 "5(b) no gravity term, t = 3 s" \
+    "5(c) gravity term, t = 3 s" fig5_dip --camera 1.0,1.4,3.0 --look-at 0,0.72,0
 }
 still_fig6a() { still fig6a_drip_uniform 60 --look-at 0,1.4,0 --zoom 1.3; }
 still_fig6b() { still fig6b_drip_diagonal 60 --look-at 0,1.2,0 --zoom 1.3; }
 still_fig9() {
-  local f=233 cam=(--camera 1.6,1.6,2.0 --look-at 0,0.7,0)
-  run fig9a_ball_no_sticking $f
-  run fig9b_ball_sticking $f
-  render fig9a_ball_no_sticking $f "$work/render/fig9a.png" "${cam[@]}"
-  render fig9b_ball_sticking $f "$work/render/fig9b.png" "${cam[@]}"
-  pair "$work/render/fig9a.png" "9(a) no sticking, t = 7 s" \
-       "$work/render/fig9b.png" "9(b) sticking, t = 7 s" fig9_ball
-  palette "$work/render/fig9a.png" fig9a_ball_no_sticking  # each half alone as well (README.md shows 9(a))
-  palette "$work/render/fig9b.png" fig9b_ball_sticking
+  side_by_side fig9a_ball_no_sticking fig9b_ball_sticking 233 "9(a) no sticking, t = 7 s" \
+    "9(b) sticking, t = 7 s" fig9_ball --camera 1.6,1.6,2.0 --look-at 0,0.7,0
 }
 still_dam_break() { still dam_break 20; }
 still_drape_sphere() { still drape_sphere 60; }
