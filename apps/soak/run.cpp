@@ -270,13 +270,11 @@ int validateCommand(const ValidateOptions& o) {
                   static_cast<double>(e.end));
   }
   std::printf("  dt:          %g s, %d substeps\n", static_cast<double>(s.dt), s.substeps);
-  if (s.fluidMaxIterations > s.fluidIterations)
-    std::printf("  iterations:  fluid %d (up to %d to a %g mean compression), cloth %d, coupling %d\n",
-                s.fluidIterations, s.fluidMaxIterations, static_cast<double>(s.fluidTolerance), s.clothIterations,
-                s.couplingIterations);
-  else
-    std::printf("  iterations:  fluid %d, cloth %d, coupling %d\n", s.fluidIterations, s.clothIterations,
-                s.couplingIterations);
+  const std::string upTo = s.fluidMaxIterations > s.fluidIterations
+                               ? fmt::format(" (up to {} to a {:g} mean compression)", s.fluidMaxIterations, s.fluidTolerance)
+                               : std::string();
+  std::printf("  iterations:  fluid %d%s, cloth %d, coupling %d\n", s.fluidIterations, upTo.c_str(), s.clothIterations,
+              s.couplingIterations);
   if (m.wetting.enabled)
     std::printf("  wetting:     Shao 2017, %s\n", m.wetting.everySubstep ? "after every substep" : "once a step (Algorithm 1)");
   std::printf("  output:      %d frames of %d steps (%g s simulated)\n", scene.output.frames,
