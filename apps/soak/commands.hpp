@@ -15,7 +15,8 @@ namespace soak::cli {
 inline constexpr const char* kVersion = SOAK_VERSION;  // project(soak VERSION ...) in CMakeLists.txt
 
 // exit codes: 0 success, 1 bad input or I/O error (nothing or little was done), 2 the simulation
-// diverged (checkState failed; the bad frame was written)
+// diverged (checkState failed; the bad frame was written), 128 + the signal when SIGINT or SIGTERM
+// stopped a run (a checkpoint was written)
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitError = 1;
 inline constexpr int kExitDiverged = 2;
@@ -26,7 +27,17 @@ struct RunOptions {
   int frames = -1;                     // -1: the scene's output.frames
   int threads = 0;                     // 0: OpenMP default
   std::vector<std::string> overrides;  // --set key=value
+  int checkpointEvery = 0;             // frames between checkpoints; 0: only on SIGINT / SIGTERM
   bool overwrite = false;
+  bool quiet = false;
+  std::vector<std::string> commandLine;
+};
+
+struct ResumeOptions {
+  std::string dir;                     // a run's output folder
+  int frames = -1;                     // -1: run.json's frames (a larger value extends the run)
+  int threads = 0;
+  int checkpointEvery = -1;            // -1: run.json's checkpointEvery
   bool quiet = false;
   std::vector<std::string> commandLine;
 };
@@ -51,6 +62,7 @@ struct BenchOptions {
 };
 
 int runCommand(const RunOptions& o);
+int resumeCommand(const ResumeOptions& o);
 int validateCommand(const ValidateOptions& o);
 int benchCommand(const BenchOptions& o);
 

@@ -39,8 +39,22 @@ int realMain(int argc, char** argv) {
       ->check(checkOverride)
       ->allow_extra_args(false)
       ->take_all();
+  runCmd->add_option("--checkpoint-every", run.checkpointEvery,
+                     "write DIR/checkpoint.soak every N frames and after the last (SIGINT / SIGTERM always write one)")
+      ->check(CLI::Range(1, 1000000));
   runCmd->add_flag("--overwrite", run.overwrite, "write into a non-empty output directory, replacing soak's files");
   runCmd->add_flag("-q,--quiet", run.quiet, "no progress and no summary");
+
+  ResumeOptions resume;
+  resume.commandLine = run.commandLine;
+  CLI::App* resumeCmd = app.add_subcommand("resume", "continue a run from its checkpoint (DIR/checkpoint.soak)");
+  resumeCmd->add_option("dir", resume.dir, "the run's output directory")->required();
+  resumeCmd->add_option("--frames", resume.frames, "last frame to write (default: run.json's frames; larger extends the run)")
+      ->check(CLI::Range(1, 100000000));
+  resumeCmd->add_option("--threads", resume.threads, "worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  resumeCmd->add_option("--checkpoint-every", resume.checkpointEvery, "frames between checkpoints (default: the run's)")
+      ->check(CLI::Range(0, 1000000));
+  resumeCmd->add_flag("-q,--quiet", resume.quiet, "no progress and no summary");
 
   ValidateOptions val;
   CLI::App* valCmd = app.add_subcommand("validate", "load and check a scene, print a summary");
@@ -91,6 +105,7 @@ int realMain(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitError;
   }
   if (*runCmd) return runCommand(run);
+  if (*resumeCmd) return resumeCommand(resume);
   if (*valCmd) return validateCommand(val);
   if (*renderCmd) return renderCommand(render);
   if (*surfaceCmd) return surfaceCommand(surface);

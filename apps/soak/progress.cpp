@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,8 +28,12 @@ std::string busyMachineHint(int threads) {
   return text;
 }
 
-Progress::Progress(int frames, bool enabled)
-    : frames_(frames), enabled_(enabled), tty_(::isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+Progress::Progress(int frames, bool enabled, int firstFrame)
+    : frames_(frames),
+      firstFrame_(firstFrame),
+      enabled_(enabled),
+      tty_(::isatty(STDERR_FILENO) != 0),
+      start_(std::chrono::steady_clock::now()) {}
 
 std::string Progress::formatDuration(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
@@ -44,7 +49,7 @@ double Progress::seconds() const {
 
 void Progress::update(int frame, double simTime, double msPerStep) {
   if (!enabled_ || frames_ <= 0) return;
-  const double eta = seconds() / frame * (frames_ - frame);
+  const double eta = seconds() / std::max(1, frame - firstFrame_) * (frames_ - frame);
   show(frame, frames_,
        fmt::format("frame {}/{}  t = {:.3f} s  {:.1f} ms/step  ETA {}", frame, frames_, simTime, msPerStep,
                    formatDuration(eta)));

@@ -7,8 +7,9 @@ namespace soak::cli {
 
 class Progress {
  public:
-  Progress(int frames, bool enabled);
-  // after frame `frame` (1..frames) at simulated time t (s) with the frame's mean ms per step
+  // frames firstFrame + 1 .. frames are to come (a resumed run starts past 0)
+  Progress(int frames, bool enabled, int firstFrame = 0);
+  // after frame `frame` (firstFrame + 1 .. frames) at simulated time t (s) with the frame's mean ms per step
   void update(int frame, double simTime, double msPerStep);
   // after `done` of `total` items of any kind: "<what> done/total  ELAPSED elapsed  ETA ..."
   void updateItems(const char* what, int done, int total);
@@ -20,7 +21,7 @@ class Progress {
   static std::string formatDuration(double seconds);
 
  private:
-  int frames_;
+  int frames_, firstFrame_;
   bool enabled_, tty_;
   int lastDecile_ = 0;
   bool drawn_ = false;

@@ -1,45 +1,26 @@
 // `soak run` and `soak validate`: load a scene, simulate it frame by frame and write the frames
 #include "commands.hpp"
 
+#include <soak/checkpoint.hpp>
 #include <soak/error.hpp>
 #include <soak/output.hpp>
 #include <soak/scene.hpp>
 #include <soak/step.hpp>
 #include <soak/threads.hpp>
 
+#include "frame_loop.hpp"
 #include "progress.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
-#include <ctime>
 #include <filesystem>
-#include <regex>
 
 namespace soak::cli {
 
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-std::string isoTimeNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return buf;
-}
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// the files a run writes; --overwrite removes only these, never anything else in the directory
-bool isSoakOutput(const std::string& name) {
-  static const std::regex frameFile(R"((cloth|water)_\d{4,}\.(obj|ply))");
-  return name == "stats.jsonl" || name == "scene.json" || name == "run.json" || std::regex_match(name, frameFile);
-}
 
 void prepareOutputDir(const std::string& dir, bool overwrite) {
   std::error_code ec;
@@ -56,136 +37,6 @@ void prepareOutputDir(const std::string& dir, bool overwrite) {
   }
   fs::create_directories(dir, ec);
   if (ec) throw Error(dir + ": cannot create the output directory: " + ec.message());
-}
-
-nlohmann::ordered_json waterJson(const WaterMass& w, const State& s) {
-  return {{"freeKg", w.free},
-          {"heldInClothKg", w.heldInCloth},
-          {"inBuffersKg", w.inBuffers},
-          {"emittedKg", w.emitted},
-          {"removedAtBoundsKg", w.removedAtBounds},
-          {"particlesRemovedAtBounds", s.ledger.particlesRemovedAtBounds},
-          {"takenByClothKg", w.takenByCloth},
-          {"unaccountedKg", w.emitted - w.total}};
-}
-
-std::string outputList(const Model& model, const OutputSettings& out) {
-  std::string s;
-  if (model.numCloth > 0 && out.clothObj) s += "cloth_NNNN.obj, ";
-  if (model.numCloth > 0 && out.clothPly) s += "cloth_NNNN.ply, ";
-  if (out.water) s += "water_NNNN.ply, ";
-  return s + "stats.jsonl";
-}
-
-// run.json: the run's settings, rewritten with its status, the frames written so far, the times, the
-// state's hash and the water's ledger
-struct RunRecord {
-  nlohmann::ordered_json run;
-  std::string path;
-  Clock::time_point wallStart;
-
-  void write(const std::string& status, int framesWritten, const State& state) {
-    run["status"] = status;
-    run["framesWritten"] = framesWritten;
-    run["wallSeconds"] = secondsSince(wallStart);
-    run["steps"] = state.stepCount;
-    run["simulatedSeconds"] = state.time;
-    run["stateHash"] = fmt::format("{:016x}", stateHash(state));
-    run["water"] = waterJson(waterMass(state), state);
-    writeTextFile(path, run.dump(2) + "\n");
-  }
-};
-
-// how the frame loop ended, for the summary
-struct FrameLoopResult {
-  int exitCode = kExitOk;
-  StageTimes ms;            // summed over the run, for the summary's wetting line
-  double simSeconds = 0.0;  // wall time from the first step to the last frame written
-};
-
-// frames 0 (the initial state) to `frames`, each written with its line of stats.jsonl; stops at the
-// first diverged frame (written too, marked "error"). run.json follows the status
-FrameLoopResult simulateFrames(Scene& scene, const RunOptions& o, const fs::path& dir, int frames, RunRecord& record) {
-  const Model& model = scene.model;
-  State& state = scene.state;
-  const OutputSettings& out = scene.output;
-  const int stepsPerFrame = std::max(1, out.stepsPerFrame);
-  const float dt = model.solver.dt;
-  JsonLinesWriter stats((dir / "stats.jsonl").string());
-  WorkspacePtr ws = makeWorkspace();
-  Progress progress(frames, !o.quiet);
-  const Clock::time_point simStart = Clock::now();
-  int written = 0;
-  FrameLoopResult result;
-  try {
-    for (int frame = 0; frame <= frames; ++frame) {
-      FrameStats fs;
-      for (int s = 0; frame > 0 && s < stepsPerFrame; ++s) {
-        StepStats st;
-        step(model, state, *ws, dt, st);
-        fs.add(st);
-      }
-      result.ms += fs.ms;
-      const std::string bad = checkState(model, state);
-      writeFrame(dir.string(), model, state, out, frame);  // a diverged frame too: it shows where the blow-up started
-      nlohmann::ordered_json line = frameStatsJson(model, state, frame, fs);
-      if (!bad.empty()) line["error"] = bad;
-      stats.write(line);
-      ++written;
-      if (!bad.empty()) {
-        progress.finish();
-        record.write("diverged", written, state);
-        std::fprintf(stderr,
-                     "soak: simulation diverged at frame %d (t = %.4f s, step %llu): %s\n"
-                     "soak: frame %d was written to %s and marked \"error\" in stats.jsonl; the last good frame is "
-                     "%d\n",
-                     frame, state.time, static_cast<unsigned long long>(state.stepCount), bad.c_str(), frame,
-                     o.outDir.c_str(), frame - 1);
-        result.exitCode = kExitDiverged;
-        return result;
-      }
-      if (frame > 0) progress.update(frame, state.time, fs.ms.total / std::max(1, fs.steps));
-    }
-  } catch (const Error&) {
-    progress.finish();
-    record.write("error", written, state);
-    throw;
-  }
-  progress.finish();
-  record.write("ok", written, state);
-  result.simSeconds = secondsSince(simStart);
-  return result;
-}
-
-// the summary on stdout: what was written, the steps' time (the wetting's stages apart, as Table 2 of
-// Shao 2017) and where the emitted water went
-void printRunSummary(const Scene& scene, const RunOptions& o, int frames, const FrameLoopResult& r) {
-  const Model& model = scene.model;
-  const State& state = scene.state;
-  const float dt = model.solver.dt;
-  const WaterMass w = waterMass(state);
-  std::printf("soak: wrote frames 0..%d of %s to %s (%s, scene.json, run.json)\n", frames, scene.name.c_str(),
-              o.outDir.c_str(), outputList(model, scene.output).c_str());
-  std::printf("soak: %llu steps of %g s in %s (%.2f ms/step) on %d threads\n",
-              static_cast<unsigned long long>(state.stepCount), static_cast<double>(dt),
-              Progress::formatDuration(r.simSeconds).c_str(),
-              state.stepCount > 0 ? 1e3 * r.simSeconds / static_cast<double>(state.stepCount) : 0.0, threadCount());
-  if (model.wetting.enabled && state.stepCount > 0) {
-    // Table 2 of Shao 2017 gives the wetting's time apart from the step's: the same split, stage by stage
-    const double steps = static_cast<double>(state.stepCount);
-    std::string parts;
-    for (int k = static_cast<int>(StagePart::wettingPorosity); k <= static_cast<int>(StagePart::wettingFinish); ++k) {
-      const std::string name = kStagePartNames[k];  // "wetting.porosity": the stage's name after the dot
-      parts += fmt::format("{}{} {:.2f}", parts.empty() ? "" : ", ", name.substr(name.find('.') + 1), r.ms.parts[k] / steps);
-    }
-    std::printf("soak: solver %.2f ms a step (frames not written), of which wetting %.2f (%s)\n", r.ms.total / steps,
-                r.ms.wetting / steps, parts.c_str());
-  }
-  std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
-              "removed at bounds %.6g kg (%llu particles) + taken in by garments %.6g kg; unaccounted %.3g kg\n",
-              w.emitted, w.free, w.heldInCloth, w.inBuffers, w.removedAtBounds,
-              static_cast<unsigned long long>(state.ledger.particlesRemovedAtBounds), w.takenByCloth,
-              w.emitted - w.total);
 }
 
 }  // namespace
@@ -220,7 +71,8 @@ int runCommand(const RunOptions& o) {
 
   prepareOutputDir(o.outDir, o.overwrite);
   const fs::path dir(o.outDir);
-  writeTextFile((dir / "scene.json").string(), sceneAsRun(o.scene, o.overrides));
+  const std::string sceneText = sceneAsRun(o.scene, o.overrides);
+  writeTextFile((dir / "scene.json").string(), sceneText);
   nlohmann::ordered_json run = {{"soak", kVersion},
                         {"threads", threadCount()},
                         {"commandLine", joinCommandLine(o.commandLine)},
@@ -231,12 +83,19 @@ int runCommand(const RunOptions& o) {
                         {"dt", std::stod(fmt::format("{}", dt))},
                         {"startTime", startTime},
                         {"status", "running"}};
+  if (o.checkpointEvery > 0) run["checkpointEvery"] = o.checkpointEvery;
   RunRecord record{std::move(run), (dir / "run.json").string(), wallStart};
   record.write("running", 0, scene.state);
 
-  const FrameLoopResult result = simulateFrames(scene, o, dir, frames, record);
+  JsonLinesWriter stats((dir / "stats.jsonl").string());
+  FrameLoop loop;
+  loop.lastFrame = frames;
+  loop.checkpointEvery = o.checkpointEvery;
+  loop.sceneHash = textHash(sceneText);
+  loop.quiet = o.quiet;
+  const FrameLoopResult result = simulateFrames(scene, loop, dir, stats, record);
   if (result.exitCode != kExitOk) return result.exitCode;
-  if (!o.quiet) printRunSummary(scene, o, frames, result);
+  if (!o.quiet) printRunSummary(scene, o.outDir, 0, frames, result);
   return kExitOk;
 }
 

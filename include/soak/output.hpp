@@ -58,8 +58,9 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
 // appends JSON lines to a file, flushing after each line so a crashed run keeps its stats
 class JsonLinesWriter {
  public:
-  // opens (truncating) `path`; throws soak::Error naming it on failure
-  explicit JsonLinesWriter(const std::string& path);
+  // opens `path`, truncating it or, with append, adding after its lines (a resumed run); throws
+  // soak::Error naming it on failure
+  explicit JsonLinesWriter(const std::string& path, bool append = false);
   void write(const nlohmann::ordered_json& line);
   const std::string& path() const { return path_; }
 

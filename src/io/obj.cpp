@@ -52,10 +52,10 @@ void writeClothObj(const std::string& path, const Model& model, const State& sta
     own = clothVertexNormals(model, state.particles.x);
     normals = own;
   }
-  std::ofstream out = openForWrite(path);
+  AtomicFile file(path);
   fmt::memory_buffer buf;
   const auto flush = [&] {
-    out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+    file.out().write(buf.data(), static_cast<std::streamsize>(buf.size()));
     buf.clear();
   };
   fmt::format_to(std::back_inserter(buf), "# soak cloth: {} particles, {} triangles, {} pieces\n", model.numCloth,
@@ -81,7 +81,7 @@ void writeClothObj(const std::string& path, const Model& model, const State& sta
     if (buf.size() > (1u << 20)) flush();
   }
   flush();
-  finishWrite(out, path);
+  file.commit();
 }
 
 }  // namespace soak

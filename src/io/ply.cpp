@@ -36,10 +36,10 @@ bool validName(const std::string& s) {
 }
 
 void writeAll(const std::string& path, const std::string& header, const std::vector<char>& body) {
-  std::ofstream out = openForWrite(path);
-  out.write(header.data(), static_cast<std::streamsize>(header.size()));
-  out.write(body.data(), static_cast<std::streamsize>(body.size()));
-  finishWrite(out, path);
+  AtomicFile file(path);
+  file.out().write(header.data(), static_cast<std::streamsize>(header.size()));
+  file.out().write(body.data(), static_cast<std::streamsize>(body.size()));
+  file.commit();
 }
 
 }  // namespace

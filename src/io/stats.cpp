@@ -107,7 +107,8 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
   return j;
 }
 
-JsonLinesWriter::JsonLinesWriter(const std::string& path) : path_(path), out_(openForWrite(path)) {}
+JsonLinesWriter::JsonLinesWriter(const std::string& path, bool append)
+    : path_(path), out_(append ? openForAppend(path) : openForWrite(path)) {}
 
 void JsonLinesWriter::write(const nlohmann::ordered_json& line) {
   out_ << line.dump() << '\n';

@@ -42,6 +42,18 @@ std::vector<int> findFrames(const std::string& dir) {
   return {frames.begin(), frames.end()};
 }
 
+// run.json's count of complete frames (frames 0..n-1), -1 when it has none: the frame files are each
+// renamed into place when complete, but a run that died between two renames, or a resume that has
+// not yet replaced a later frame, can leave files that run.json does not count
+int framesWritten(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "run.json").string();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return -1;
+  const nlohmann::json j = nlohmann::json::parse(readTextFile(path), nullptr, false);
+  if (!j.is_object() || !j.contains("framesWritten") || !j["framesWritten"].is_number_integer()) return -1;
+  return j["framesWritten"].get<int>();
+}
+
 std::map<int, double> readStatsTimes(const std::string& path) {
   std::map<int, double> times;
   std::error_code ec;
@@ -175,6 +187,7 @@ RunOutput openRunOutput(const std::string& dir) {
   run.dir = dir;
   run.scene = loadScene(scenePath);
   run.frames = findFrames(dir);
+  if (const int n = framesWritten(dir); n >= 0) std::erase_if(run.frames, [n](int f) { return f >= n; });
   if (run.frames.empty())
     throw Error(dir + ": no frame files (cloth_NNNN.ply, cloth_NNNN.obj or water_NNNN.ply) in the output folder");
   run.statsTime = readStatsTimes((fs::path(dir) / "stats.jsonl").string());

@@ -13,7 +13,8 @@ namespace soak {
 struct RunOutput {
   std::string dir;
   Scene scene;                      // DIR/scene.json, loaded and validated
-  std::vector<int> frames;          // frame numbers with at least one frame file, ascending
+  std::vector<int> frames;          // frame numbers with at least one frame file that run.json counts
+                                    // as written (all of them without a run.json), ascending
   std::map<int, double> statsTime;  // s, the "time" of each stats.jsonl line (when present)
 
   // simulated time of a frame: stats.jsonl's, else frame * stepsPerFrame * dt

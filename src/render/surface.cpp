@@ -257,7 +257,8 @@ void writeSurfaceObj(const std::string& path, const SurfaceMesh& mesh) {
 }
 
 void writeSurfacePly(const std::string& path, const SurfaceMesh& mesh) {
-  std::ofstream out = openForWrite(path);
+  AtomicFile file(path);
+  std::ofstream& out = file.out();
   out << "ply\nformat binary_little_endian 1.0\ncomment soak water surface, SI units (m), y up\n"
       << "element vertex " << mesh.vertices.size() << "\n"
       << "property float x\nproperty float y\nproperty float z\n"
@@ -281,7 +282,7 @@ void writeSurfacePly(const std::string& path, const SurfaceMesh& mesh) {
     put(ids, sizeof ids);
   }
   out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
-  finishWrite(out, path);
+  file.commit();
 }
 
 }  // namespace soak

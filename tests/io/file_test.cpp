@@ -97,6 +97,30 @@ TEST(IoFile, AFullDiskIsAWriteFailureNamingTheFile) {
   std::ofstream out = openForWrite("/dev/full");
   out << "x";
   EXPECT_THROW(finishWrite(out, "/dev/full"), Error);
+  EXPECT_TRUE(fs::is_character_file("/dev/full")) << "a device was replaced by a renamed file";
+}
+
+// a file being written lives under NAME.part: the old file stays whole until commit() replaces it,
+// and a write abandoned (an exception, a full disk) leaves the old file and no .part behind
+TEST(IoFile, AnAtomicFileReplacesTheOldOneOnlyWhenComplete) {
+  const fs::path dir = tempDir("atomic");
+  const std::string path = (dir / "frame.txt").string();
+  writeTextFile(path, "old");
+  {
+    AtomicFile f(path);
+    f.out() << "new, half written";
+    f.out().flush();
+    EXPECT_EQ(readTextFile(path), "old");
+    EXPECT_TRUE(fs::exists(path + ".part"));
+  }
+  EXPECT_EQ(readTextFile(path), "old");
+  EXPECT_FALSE(fs::exists(path + ".part"));
+  AtomicFile f(path);
+  f.out() << "new";
+  f.commit();
+  EXPECT_EQ(readTextFile(path), "new");
+  EXPECT_FALSE(fs::exists(path + ".part"));
+  fs::remove_all(dir);
 }
 
 // a full disk is named as such, also when the failing write was a block written at once (larger than
