@@ -187,7 +187,10 @@ RunOutput openRunOutput(const std::string& dir) {
   run.dir = dir;
   run.scene = loadScene(scenePath);
   run.frames = findFrames(dir);
+  const bool anyFile = !run.frames.empty();
   if (const int n = framesWritten(dir); n >= 0) std::erase_if(run.frames, [n](int f) { return f >= n; });
+  if (run.frames.empty() && anyFile)
+    throw Error(dir + ": no complete frame yet (run.json counts " + std::to_string(framesWritten(dir)) + " frames written)");
   if (run.frames.empty())
     throw Error(dir + ": no frame files (cloth_NNNN.ply, cloth_NNNN.obj or water_NNNN.ply) in the output folder");
   run.statsTime = readStatsTimes((fs::path(dir) / "stats.jsonl").string());

@@ -85,6 +85,20 @@ TEST(RenderRunOutput, FramesAndTheirTimes) {
   EXPECT_FLOAT_EQ(run.scene.model.water.particleMass, 0.005f);
 }
 
+// run.json's framesWritten bounds the frames (a run in progress, or killed between two files, or a
+// resume that has not yet replaced a later frame); a run.json without it, or broken, does not
+TEST(RenderRunOutput, OnlyTheFramesRunJsonCountsAsWritten) {
+  const RunFolder f("counted");
+  writeTextFile((f.dir / "run.json").string(), R"({"status": "running", "framesWritten": 3})");
+  EXPECT_EQ(openRunOutput(f.str()).frames, (std::vector<int>{0, 2}));
+  writeTextFile((f.dir / "run.json").string(), R"({"status": "ok", "framesWritten": 6})");
+  EXPECT_EQ(openRunOutput(f.str()).frames, (std::vector<int>{0, 2, 5}));
+  writeTextFile((f.dir / "run.json").string(), R"({"status": "running", "frame)");
+  EXPECT_EQ(openRunOutput(f.str()).frames, (std::vector<int>{0, 2, 5}));
+  writeTextFile((f.dir / "run.json").string(), R"({"status": "running", "framesWritten": 0})");
+  EXPECT_NE(errorOf([&] { openRunOutput(f.str()); }).find("no complete frame yet"), std::string::npos);
+}
+
 // what is wrong with the folder, in words, with the folder's name
 TEST(RenderRunOutput, FolderErrorsSayWhatIsMissing) {
   const RunFolder f("errors");
