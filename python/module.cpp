@@ -2,6 +2,7 @@
 // state's arrays as numpy views of the engine's own memory, moves pinned particles and colliders
 // between steps and writes frames as `soak run` does
 #include "simulation.hpp"
+#include "views.hpp"
 
 #include <soak/threads.hpp>
 
@@ -15,32 +16,33 @@
 
 namespace py = pybind11;
 using soak::python::Simulation;
+using soak::python::view;
+using soak::python::viewOf;
 
 namespace {
 
-static_assert(sizeof(soak::Vec3) == 3 * sizeof(float), "a Vec3 array is read as n x 3 floats");
+// the Python object: the simulation and the watch over its views
+class PySimulation : public Simulation {
+ public:
+  explicit PySimulation(Simulation&& s) : Simulation(std::move(s)) {}
+  soak::python::StateViews views;
+};
 
-// a numpy array over `data` (no copy) whose base is `owner`, the Python Simulation, so the memory's
-// owner lives as long as the view. Valid until the next step (docs/python.md: the vectors may grow)
-py::array viewOf(py::handle owner, const py::dtype& dtype, std::vector<py::ssize_t> shape,
-                 std::vector<py::ssize_t> strides, const void* data, bool writable) {
-  py::array a(dtype, std::move(shape), std::move(strides), data, owner);
-  if (!writable) py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return a;
-}
+PySimulation& sim(py::handle self) { return self.cast<PySimulation&>(); }
 
+// a property showing one of the State's vectors, watched for staleness after each step
 template <class T>
-py::array view(py::handle owner, const std::vector<T>& v, bool writable) {
-  return viewOf(owner, py::dtype::of<T>(), {static_cast<py::ssize_t>(v.size())}, {sizeof(T)}, v.data(), writable);
+void defStateArray(py::class_<PySimulation>& c, const char* name, std::vector<T>& (*get)(soak::State&), bool writable) {
+  c.def_property_readonly(name, [get, writable](py::handle self) {
+    PySimulation& s = sim(self);
+    py::array a = view(self, get(s.state()), writable);
+    s.views.watch(a, [get](soak::State& st) {
+      const std::vector<T>& v = get(st);
+      return std::pair<const void*, size_t>(v.data(), v.size());
+    }, s.state());
+    return a;
+  });
 }
-
-// n x 3 float32 over a vector of Vec3
-py::array view3(py::handle owner, const std::vector<soak::Vec3>& v, bool writable) {
-  return viewOf(owner, py::dtype::of<float>(), {static_cast<py::ssize_t>(v.size()), 3},
-                {sizeof(soak::Vec3), sizeof(float)}, v.data(), writable);
-}
-
-Simulation& sim(py::handle self) { return self.cast<Simulation&>(); }
 
 // a collider by index or name
 int colliderOf(const Simulation& s, const py::object& collider) {
@@ -59,7 +61,7 @@ void bindLoading(py::module_& m) {
   m.def(
       "load",
       [](const std::string& path, const std::vector<std::string>& overrides) {
-        return Simulation(soak::loadScene(path, overrides), soak::sceneAsRun(path, overrides));
+        return PySimulation(Simulation(soak::loadScene(path, overrides), soak::sceneAsRun(path, overrides)));
       },
       py::arg("path"), py::arg("overrides") = std::vector<std::string>{},
       "Loads a scene file; overrides are \"json.path=value\" strings as soak run's --set.");
@@ -69,7 +71,7 @@ void bindLoading(py::module_& m) {
         const std::string text = py::module_::import("json").attr("dumps")(scene, py::arg("indent") = 2).cast<std::string>();
         const std::string base = baseDir.is_none() ? py::module_::import("os").attr("getcwd")().cast<std::string>()
                                                    : py::str(baseDir).cast<std::string>();
-        return Simulation(soak::loadSceneFromString(text, "<dict>", base, overrides), text + "\n");
+        return PySimulation(Simulation(soak::loadSceneFromString(text, "<dict>", base, overrides), text + "\n"));
       },
       py::arg("scene"), py::arg("base_dir") = py::none(), py::arg("overrides") = std::vector<std::string>{},
       "Loads a scene from a dict with a scene file's keys; relative mesh paths resolve against base_dir "
@@ -78,22 +80,20 @@ void bindLoading(py::module_& m) {
   m.def("threads", &soak::threadCount, "The worker threads the parallel loops use.");
 }
 
-void bindArrays(py::class_<Simulation>& c) {
-  const auto particles = [](py::handle self) -> soak::Particles& { return sim(self).state().particles; };
-  c.def_property_readonly("positions", [=](py::handle self) { return view3(self, particles(self).x, true); });
-  c.def_property_readonly("predicted_positions",
-                          [=](py::handle self) { return view3(self, particles(self).xPred, true); });
-  c.def_property_readonly("velocities", [=](py::handle self) { return view3(self, particles(self).v, true); });
-  c.def_property_readonly("masses", [=](py::handle self) { return view(self, particles(self).mass, false); });
-  c.def_property_readonly("inv_masses", [=](py::handle self) { return view(self, particles(self).invMass, false); });
-  c.def_property_readonly("radii", [=](py::handle self) { return view(self, particles(self).radius, false); });
-  c.def_property_readonly("phases", [=](py::handle self) { return view(self, particles(self).phase, false); });
-  c.def_property_readonly("ids", [=](py::handle self) { return view(self, particles(self).id, false); });
-  c.def_property_readonly("saturation",
-                          [](py::handle self) { return view(self, sim(self).state().clothSaturation, false); });
-  c.def_property_readonly("cloth_water", [](py::handle self) { return view(self, sim(self).state().clothWater, false); });
-  c.def_property_readonly("cloth_buffer",
-                          [](py::handle self) { return view(self, sim(self).state().clothBuffer, false); });
+void bindArrays(py::class_<PySimulation>& c) {
+  using soak::State;
+  using soak::Vec3;
+  defStateArray<Vec3>(c, "positions", [](State& s) -> std::vector<Vec3>& { return s.particles.x; }, true);
+  defStateArray<Vec3>(c, "predicted_positions", [](State& s) -> std::vector<Vec3>& { return s.particles.xPred; }, true);
+  defStateArray<Vec3>(c, "velocities", [](State& s) -> std::vector<Vec3>& { return s.particles.v; }, true);
+  defStateArray<float>(c, "masses", [](State& s) -> std::vector<float>& { return s.particles.mass; }, false);
+  defStateArray<float>(c, "inv_masses", [](State& s) -> std::vector<float>& { return s.particles.invMass; }, false);
+  defStateArray<float>(c, "radii", [](State& s) -> std::vector<float>& { return s.particles.radius; }, false);
+  defStateArray<int32_t>(c, "phases", [](State& s) -> std::vector<int32_t>& { return s.particles.phase; }, false);
+  defStateArray<uint32_t>(c, "ids", [](State& s) -> std::vector<uint32_t>& { return s.particles.id; }, false);
+  defStateArray<float>(c, "saturation", [](State& s) -> std::vector<float>& { return s.clothSaturation; }, false);
+  defStateArray<double>(c, "cloth_water", [](State& s) -> std::vector<double>& { return s.clothWater; }, false);
+  defStateArray<double>(c, "cloth_buffer", [](State& s) -> std::vector<double>& { return s.clothBuffer; }, false);
   c.def_property_readonly("pinned", [](py::handle self) { return view(self, sim(self).model().clothPinned, false); });
   c.def_property_readonly("triangles", [](py::handle self) {
     const auto& t = sim(self).model().triangles;
@@ -103,39 +103,50 @@ void bindArrays(py::class_<Simulation>& c) {
   c.def_property_readonly("ledger", [](py::handle self) {
     return viewOf(self, py::dtype::of<soak::WaterLedger>(), {}, {}, &sim(self).state().ledger, false);
   });
-  c.def("water_mass", [](Simulation& s) {
+  c.def("water_mass", [](PySimulation& s) {
     const soak::WaterMass w = soak::waterMass(s.state());
     return py::dict(py::arg("free") = w.free, py::arg("heldInCloth") = w.heldInCloth,
                     py::arg("inBuffers") = w.inBuffers, py::arg("emitted") = w.emitted,
                     py::arg("removedAtBounds") = w.removedAtBounds, py::arg("takenByCloth") = w.takenByCloth,
                     py::arg("total") = w.total);
-  });
+  }, "Where the water is now (kg): free, heldInCloth, inBuffers, emitted, removedAtBounds, takenByCloth, total.");
 }
 
-void bindScalars(py::class_<Simulation>& c) {
-  c.def_property_readonly("name", [](const Simulation& s) { return s.scene().name; });
-  c.def_property_readonly("description", [](const Simulation& s) { return s.scene().description; });
-  c.def_property_readonly("time", [](Simulation& s) { return s.state().time; });
-  c.def_property_readonly("step_count", [](Simulation& s) { return s.state().stepCount; });
-  c.def_property_readonly("dt", [](const Simulation& s) { return s.model().solver.dt; });
-  c.def_property_readonly("num_particles", [](Simulation& s) { return s.state().particles.size(); });
-  c.def_property_readonly("num_cloth", [](const Simulation& s) { return s.model().numCloth; });
-  c.def_property_readonly("frames", [](const Simulation& s) { return s.scene().output.frames; });
-  c.def_property_readonly("steps_per_frame", [](const Simulation& s) { return s.scene().output.stepsPerFrame; });
-  c.def_property_readonly("collider_names", [](const Simulation& s) {
+void bindScalars(py::class_<PySimulation>& c) {
+  c.def_property_readonly("name", [](const PySimulation& s) { return s.scene().name; });
+  c.def_property_readonly("description", [](const PySimulation& s) { return s.scene().description; });
+  c.def_property_readonly("time", [](PySimulation& s) { return s.state().time; });
+  c.def_property_readonly("step_count", [](PySimulation& s) { return s.state().stepCount; });
+  c.def_property_readonly("dt", [](const PySimulation& s) { return s.model().solver.dt; });
+  c.def_property_readonly("num_particles", [](PySimulation& s) { return s.state().particles.size(); });
+  c.def_property_readonly("num_cloth", [](const PySimulation& s) { return s.model().numCloth; });
+  c.def_property_readonly("frames", [](const PySimulation& s) { return s.scene().output.frames; });
+  c.def_property_readonly("steps_per_frame", [](const PySimulation& s) { return s.scene().output.stepsPerFrame; });
+  c.def_property_readonly("collider_names", [](const PySimulation& s) {
     std::vector<std::string> names;
     for (const soak::Collider& k : s.model().colliders) names.push_back(k.name);
     return names;
   });
-  c.def("state_hash", [](Simulation& s) { return soak::stateHash(s.state()); });
-  c.def("check", [](Simulation& s) { return soak::checkState(s.model(), s.state()); });
+  c.def("state_hash", [](PySimulation& s) { return soak::stateHash(s.state()); }, "The 64-bit hash of the whole state.");
+  c.def("check", [](PySimulation& s) { return soak::checkState(s.model(), s.state()); },
+        "'' while every particle is finite and below solver.maxSpeed, else what is wrong.");
 }
 
-void bindMotion(py::class_<Simulation>& c) {
-  c.def("step", &Simulation::step, py::arg("steps") = 1, py::call_guard<py::gil_scoped_release>());
+void bindMotion(py::class_<PySimulation>& c) {
+  c.def(
+      "step",
+      [](PySimulation& s, int steps) {
+        {
+          py::gil_scoped_release release;
+          s.step(steps);
+        }
+        s.views.warnAboutStale(s.state());
+      },
+      py::arg("steps") = 1,
+        "Advances `steps` steps of dt. Views taken before are valid only while no particle was added or removed.");
   c.def(
       "move_pinned",
-      [](Simulation& s, const py::array_t<int64_t, py::array::c_style | py::array::forcecast>& indices,
+      [](PySimulation& s, const py::array_t<int64_t, py::array::c_style | py::array::forcecast>& indices,
          const py::array_t<float, py::array::c_style | py::array::forcecast>& positions) {
         if (positions.size() != 3 * indices.size())
           throw soak::Error("move_pinned: expected " + std::to_string(indices.size()) + " x 3 positions, got " +
@@ -143,19 +154,20 @@ void bindMotion(py::class_<Simulation>& c) {
         const auto* xs = reinterpret_cast<const soak::Vec3*>(positions.data());
         s.movePinned({indices.data(), static_cast<size_t>(indices.size())}, {xs, static_cast<size_t>(indices.size())});
       },
-      py::arg("indices"), py::arg("positions"));
+      py::arg("indices"), py::arg("positions"),
+      "Puts pinned cloth particles at positions (k x 3, m); they stay there until moved again.");
   c.def(
       "collider_pose",
-      [](const Simulation& s, const py::object& collider) {
+      [](const PySimulation& s, const py::object& collider) {
         const soak::Keyframe k = s.colliderPose(colliderOf(s, collider));
         const soak::Quat& q = k.rotation;
         return py::make_tuple(py::array_t<float>(3, k.translation.data()),
                               py::array_t<float>(4, std::vector<float>{q.w(), q.x(), q.y(), q.z()}.data()));
       },
-      py::arg("collider"));
+      py::arg("collider"), "(translation, rotation (w, x, y, z)) of a collider (index or name) now.");
   c.def(
       "set_collider_pose",
-      [](Simulation& s, const py::object& collider, const py::array_t<float, py::array::c_style | py::array::forcecast>& t,
+      [](PySimulation& s, const py::object& collider, const py::array_t<float, py::array::c_style | py::array::forcecast>& t,
          const py::object& rotation) {
         const int k = colliderOf(s, collider);
         soak::Quat q = s.colliderPose(k).rotation;  // no rotation given: keep the current one
@@ -166,17 +178,19 @@ void bindMotion(py::class_<Simulation>& c) {
         }
         s.setColliderPose(k, vec3Of(t, "set_collider_pose: translation"), q);
       },
-      py::arg("collider"), py::arg("translation"), py::arg("rotation") = py::none());
+      py::arg("collider"), py::arg("translation"), py::arg("rotation") = py::none(),
+      "Moves a collider (index or name) to this pose over the next step, then holds it there.");
 }
 
-void bindOutput(py::class_<Simulation>& c) {
+void bindOutput(py::class_<PySimulation>& c) {
   c.def(
       "write_frame",
-      [](Simulation& s, const py::object& dir, int frame) { return toPython(s.writeFrame(py::str(dir), frame)); },
-      py::arg("out_dir"), py::arg("frame"));
+      [](PySimulation& s, const py::object& dir, int frame) { return toPython(s.writeFrame(py::str(dir), frame)); },
+      py::arg("out_dir"), py::arg("frame"),
+      "Writes the frame files of the state now as soak run does; returns the frame's stats line.");
   c.def(
       "run",
-      [](Simulation& s, const py::object& dir, const py::object& frames, const py::object& progress, bool overwrite) {
+      [](PySimulation& s, const py::object& dir, const py::object& frames, const py::object& progress, bool overwrite) {
         const int n = frames.is_none() ? s.scene().output.frames : frames.cast<int>();
         // called between frames with the GIL held; Ctrl-C stops the run there
         const std::function<bool(int, int)> report = [&progress](int frame, int total) {
@@ -192,10 +206,13 @@ void bindOutput(py::class_<Simulation>& c) {
           py::gil_scoped_release release;
           last = s.run(out, n, overwrite, report);
         }
+        s.views.warnAboutStale(s.state());
         return toPython(last);
       },
       py::arg("out_dir"), py::arg("frames") = py::none(), py::arg("progress") = py::none(),
-      py::arg("overwrite") = false);
+      py::arg("overwrite") = false,
+      "Writes frames 0 (now) to `frames` with stats.jsonl and scene.json as soak run does; progress(frame, "
+      "frames) after each, False stops. Raises soak.DivergedError after writing a diverged frame.");
 }
 
 }  // namespace
@@ -210,7 +227,7 @@ PYBIND11_MODULE(soak, m) {
   PYBIND11_NUMPY_DTYPE(soak::WaterLedger, emitted, removedAtBounds, particlesRemovedAtBounds, heldInCloth, inBuffers,
                        particlesAbsorbed, dripsEmitted, takenByCloth, particlesTakenByCloth);
   bindLoading(m);
-  py::class_<Simulation> c(m, "Simulation", "A scene being simulated; made by soak.load or soak.load_dict.");
+  py::class_<PySimulation> c(m, "Simulation", "A scene being simulated; made by soak.load or soak.load_dict.");
   bindArrays(c);
   bindScalars(c);
   bindMotion(c);

@@ -1,6 +1,7 @@
 """The state's arrays are numpy views of the engine's memory: no copy, writes seen both ways, the
 simulation kept alive by its views, read-only where a write would break the engine's bookkeeping."""
 import gc
+import warnings
 
 import numpy as np
 import pytest
@@ -48,9 +49,30 @@ def test_a_view_sees_the_engine_write_while_nothing_is_added():
     sim = soak.load_dict(cloth_scene(pin_corners=False))  # cloth only: no particle is added or removed
     y = sim.positions[:, 1]
     before = y.copy()
-    sim.step(2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the view is not stale
+        sim.step(2)
     assert (y < before).all()  # the same view, the engine's new positions
     np.testing.assert_array_equal(y, sim.positions[:, 1])
+
+
+def test_a_view_older_than_a_step_that_added_water_is_reported_stale():
+    scene = cloth_scene()
+    scene["emitters"] = [{"type": "block", "min": [-0.05, 0.6, -0.05], "max": [0.05, 0.7, 0.05], "start": 0.025}]
+    sim = soak.load_dict(scene)
+    x = sim.positions
+    grown_at = None
+    for k in range(1, 6):
+        n = sim.num_particles
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sim.step()
+        stale = [w for w in caught if issubclass(w.category, RuntimeWarning) and "stale" in str(w.message)]
+        if sim.num_particles > n:
+            grown_at = k
+        assert len(stale) == (1 if grown_at == k else 0), k  # once, when the block arrived
+    assert grown_at is not None and x.shape[0] == sim.num_cloth
+    assert sim.positions.shape == (sim.num_particles, 3)  # a new view has the water
 
 
 def test_views_keep_the_simulation_alive():
