@@ -60,7 +60,8 @@ soak::Vec3 vec3Of(const py::array_t<float, py::array::c_style | py::array::force
 void bindLoading(py::module_& m) {
   m.def(
       "load",
-      [](const std::string& path, const std::vector<std::string>& overrides) {
+      [](const py::object& file, const std::vector<std::string>& overrides) {
+        const std::string path = py::str(file);  // a str or a pathlib.Path
         return PySimulation(Simulation(soak::loadScene(path, overrides), soak::sceneAsRun(path, overrides)));
       },
       py::arg("path"), py::arg("overrides") = std::vector<std::string>{},

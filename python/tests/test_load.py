@@ -9,7 +9,7 @@ from conftest import SCENES, cloth_scene
 
 def test_dict_equals_file():
     path = SCENES / "fig4_absorption.json"
-    from_file = soak.load(str(path))
+    from_file = soak.load(path)  # a pathlib.Path as well as a str
     from_dict = soak.load_dict(json.loads(path.read_text()), base_dir=SCENES)
     assert from_file.state_hash() == from_dict.state_hash()
     from_file.step(3)
