@@ -5,6 +5,9 @@
 #include <soak/stats.hpp>
 
 #include <memory>
+#include <span>
+#include <string>
+#include <vector>
 
 namespace soak {
 
@@ -17,8 +20,16 @@ using WorkspacePtr = std::unique_ptr<Workspace, WorkspaceDeleter>;
 WorkspacePtr makeWorkspace();
 
 // advances state by dt (split into model.solver.substeps substeps). Does not throw; a diverged
-// state is reported by checkState.
-void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats);
+// state is reported by checkState. colliderKeys: collider motion a caller sets between steps in place
+// of the scene's (a script moving a collider, python/): collider c follows colliderKeys[c] during the
+// step, as it would its own Collider::keys, when that is not empty; the Model stays as loaded.
+void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats,
+          std::span<const std::vector<Keyframe>> colliderKeys = {});
+
+// where keyframes put a collider at time t (s): translation linear and rotation slerped between
+// keys, the ends held; for a caller's colliderKeys, the pose of model.colliders[c] is
+// poseAt(model.colliders[c].keys, t)
+Keyframe poseAt(std::span<const Keyframe> keys, double t);
 
 // returns an empty string when every particle is finite and below model.solver.maxSpeed, else a
 // message naming the first bad particle

@@ -25,8 +25,8 @@ void predictPositions(const Model& model, const std::vector<IndexRange>& moved, 
   const Vec3 g = model.solver.gravity;
   const int64_t nc = model.numCloth;
   parallelForRanges(moved, [&](int64_t i) {
-    if (i < nc && model.clothPinned[i]) {
-      p.xPred[i] = model.clothRestPosition[i];
+    if (i < nc && model.clothPinned[i]) {  // stays where it is: where the scene put it, or a caller moved it
+      p.xPred[i] = p.x[i];
       p.v[i].setZero();
       return;
     }
@@ -70,9 +70,13 @@ size_t removeOutsideDomain(const Model& model, State& state, std::vector<uint8_t
   return removed;
 }
 
-void updateColliderPoses(const Model& model, double time, std::vector<ColliderPose>& poses) {
+void updateColliderPoses(const Model& model, double time, std::span<const std::vector<Keyframe>> colliderKeys,
+                         std::vector<ColliderPose>& poses) {
   poses.resize(model.colliders.size());
-  for (size_t c = 0; c < model.colliders.size(); ++c) poses[c] = colliderPose(model.colliders[c], time);
+  for (size_t c = 0; c < model.colliders.size(); ++c) {
+    const bool given = c < colliderKeys.size() && !colliderKeys[c].empty();
+    poses[c] = given ? keyframedPose(colliderKeys[c], time) : colliderPose(model.colliders[c], time);
+  }
 }
 
 float maxSupportRadius(const Particles& p) {

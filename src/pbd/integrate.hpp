@@ -16,7 +16,8 @@ namespace soak {
 // the implicit pieces' are moved by src/garment
 void pbdParticles(const Model& model, size_t n, std::vector<IndexRange>& ranges);
 
-// v += dt g; x* = x + dt v for the particles in `moved`; pinned cloth follows its rest position
+// v += dt g; x* = x + dt v for the particles in `moved`; pinned cloth stays at x with v = 0 (where the
+// scene put it, or where a caller moved it between steps)
 void predictPositions(const Model& model, const std::vector<IndexRange>& moved, Particles& p, float dt);
 
 // v = (x* - x) / dt for the particles in `moved`, plus cloth particle i's clothVelocityOffset[i] where
@@ -30,7 +31,10 @@ void commitPositions(Particles& p);
 // removes water particles outside the domain box, adding their mass to the ledger; returns how many
 size_t removeOutsideDomain(const Model& model, State& state, std::vector<uint8_t>& keep);
 
-void updateColliderPoses(const Model& model, double time, std::vector<ColliderPose>& poses);
+// every collider's pose at `time`: from colliderKeys[c] where the caller gave collider c keyframes
+// (not empty), else from its own (Collider::keys)
+void updateColliderPoses(const Model& model, double time, std::span<const std::vector<Keyframe>> colliderKeys,
+                         std::vector<ColliderPose>& poses);
 float maxSupportRadius(const Particles& p);
 
 // the neighbour grid's cell size: the largest support radius of the cloth particles and of water as

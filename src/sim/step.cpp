@@ -36,12 +36,13 @@ struct StageClock {
 
 // x* of every particle: new water, gravity, the colliders' poses at the substep's end, and the
 // implicit garments' own step (Chen 2012: Eq. 1-5, 15-19, section 3.5)
-void predict(const Model& model, State& state, Workspace& ws, float h, StepStats& stats, StageClock& clock) {
+void predict(const Model& model, State& state, Workspace& ws, float h, std::span<const std::vector<Keyframe>> colliderKeys,
+             StepStats& stats, StageClock& clock) {
   stats.emittedParticles += emitWater(model, state, state.time, h);                 // Fig. 1 jet, Fig. 3 block
   clock.lap(stats.ms.emit);
   pbdParticles(model, state.particles.size(), ws.pbdParticles);                     // water and PBD cloth
   predictPositions(model, ws.pbdParticles, state.particles, h);                    // v += dt g, x* = x + dt v
-  updateColliderPoses(model, state.time + h, ws.poses);
+  updateColliderPoses(model, state.time + h, colliderKeys, ws.poses);
   clock.lap(stats.ms.predict);
   solveGarments(model, state, ws.garment, ws.poses, h, stats);
   clock.lap(stats.ms.garment);
@@ -115,9 +116,10 @@ void wet(const Model& model, State& state, Workspace& ws, float wetDt, StageCloc
 
 // one substep of Algorithm 1. wetDt: the time the wetting stages cover, 0 to skip them (the step's
 // dt after its last substep, or the substep's h after each with wetting.everySubstep)
-void substep(const Model& model, State& state, Workspace& ws, float h, float wetDt, StepStats& stats) {
+void substep(const Model& model, State& state, Workspace& ws, float h, float wetDt,
+             std::span<const std::vector<Keyframe>> colliderKeys, StepStats& stats) {
   StageClock clock{stats.ms};
-  predict(model, state, ws, h, stats, clock);                                       // x* = x + dt v
+  predict(model, state, ws, h, colliderKeys, stats, clock);                         // x* = x + dt v
   project(model, state, ws, h, stats, clock);                                       // neighbours, constraints
   updateVelocitiesAndCommit(model, ws, state.particles, h, stats, clock);           // v, then x = x*
   if (wetDt > 0.0f) wet(model, state, ws, wetDt, clock);                            // absorb, diffuse, drip, stick
@@ -134,7 +136,8 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
 void WorkspaceDeleter::operator()(Workspace* w) const { delete w; }
 WorkspacePtr makeWorkspace() { return WorkspacePtr(new Workspace()); }
 
-void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats) {
+void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats,
+          std::span<const std::vector<Keyframe>> colliderKeys) {
   const auto start = std::chrono::steady_clock::now();
   const int n = std::max(1, model.solver.substeps);
   const float h = dt / static_cast<float>(n);
@@ -142,11 +145,17 @@ void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& 
     sortParticlesByCell(state.particles, model.numCloth, model.water.supportRadius, ws.reorder);  // neighbours close in memory
   // Algorithm 1's wetting once a step at its dt; the substeps refine the dynamics only (departure: docs/models.md)
   const bool every = model.wetting.everySubstep;
-  for (int s = 0; s < n; ++s) substep(model, state, ws, h, every ? h : (s + 1 == n ? dt : 0.0f), stats);
+  for (int s = 0; s < n; ++s)
+    substep(model, state, ws, h, every ? h : (s + 1 == n ? dt : 0.0f), colliderKeys, stats);
   stats.substeps += n;
   stats.maxSpeed = maxSpeed(state.particles);
   ++state.stepCount;
   stats.ms.total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+Keyframe poseAt(std::span<const Keyframe> keys, double t) {
+  const ColliderPose pose = keyframedPose(keys, t);
+  return {static_cast<float>(t), pose.translation, pose.rotation};
 }
 
 }  // namespace soak

@@ -93,10 +93,11 @@ float localDistance(const Collider& c, const Vec3& p, Vec3* n) {
 
 }  // namespace
 
-ColliderPose colliderPose(const Collider& c, double t) {
+ColliderPose colliderPose(const Collider& c, double t) { return keyframedPose(c.keys, t); }
+
+ColliderPose keyframedPose(std::span<const Keyframe> keys, double t) {
   ColliderPose pose;
-  if (c.keys.empty()) return pose;
-  const auto& keys = c.keys;
+  if (keys.empty()) return pose;
   if (keys.size() == 1 || t < keys.front().time) {
     pose.translation = keys.front().translation;
     pose.rotation = keys.front().rotation.normalized();

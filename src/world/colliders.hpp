@@ -6,6 +6,7 @@
 
 #include "core/parallel.hpp"
 
+#include <span>
 #include <vector>
 
 namespace soak {
@@ -22,6 +23,8 @@ struct ColliderPose {
 // pose at time t: translation interpolated linearly between keyframes, rotation by slerp, the ends
 // held; velocities from the keyframe segment containing t
 ColliderPose colliderPose(const Collider& c, double t);
+// the same for keyframes given apart from a collider (a caller's, step.hpp)
+ColliderPose keyframedPose(std::span<const Keyframe> keys, double t);
 
 // signed distance (m, negative inside the solid) from world point p to the collider, and the unit
 // outward normal of the nearest surface in `normal` (world frame)

@@ -118,3 +118,47 @@ TEST(Step, NoWaterLeaksThroughAContainerAtOneLongSubstep) {
     ASSERT_GE(p.x[i].y(), 0.0f) << "particle " << i << " at " << p.x[i].transpose();
   }
 }
+
+// a caller's keyframes move a collider through the step (the Python module's scripted colliders):
+// a drop resting on a box rises with it, and the Model's own keys are left as loaded
+TEST(Step, CallerKeyframesMoveAColliderThatPushesParticles) {
+  Scene scene = sceneFromJson(R"({
+    "solver": {"dt": 0.01, "substeps": 1, "domain": {"min": [-1, -1, -1], "max": [1, 2, 1]}},
+    "colliders": [{"type": "box", "halfExtents": [0.5, 0.05, 0.5], "position": [0, -0.05, 0]}],
+    "emitters": [{"type": "block", "min": [-0.01, 0.04, -0.01], "max": [0.01, 0.06, 0.01]}]
+  })");
+  runSteps(scene, 40);
+  ASSERT_EQ(scene.state.particles.size(), 1u);
+  const float resting = scene.state.particles.x[0].y();
+  WorkspacePtr ws = makeWorkspace();
+  const std::vector<Keyframe>& own = scene.model.colliders[0].keys;
+  std::vector<std::vector<Keyframe>> keys(1);
+  for (int k = 0; k < 20; ++k) {  // 1 m/s up for 0.2 s, one keyframe pair a step
+    const Keyframe from = poseAt(keys[0].empty() ? own : keys[0], scene.state.time);
+    keys[0] = {from, {from.time + 0.01f, from.translation + Vec3(0, 0.01f, 0), from.rotation}};
+    StepStats stats;
+    step(scene.model, scene.state, *ws, 0.01f, stats, keys);
+  }
+  EXPECT_NEAR(poseAt(keys[0], scene.state.time).translation.y(), 0.15f, 1e-5f);
+  EXPECT_NEAR(scene.state.particles.x[0].y(), resting + 0.2f, 0.01f);
+  EXPECT_NEAR(scene.state.particles.v[0].y(), 1.0f, 0.2f);
+  ASSERT_EQ(scene.model.colliders[0].keys.size(), 1u);
+  EXPECT_EQ(scene.model.colliders[0].keys[0].translation, Vec3(0, -0.05f, 0));
+}
+
+// a pinned particle stays where it is: where the scene put it, or where a caller moved it
+TEST(Step, PinnedParticleStaysWhereACallerMovedIt) {
+  Scene scene = sceneFromJson(R"({
+    "solver": {"dt": 0.01},
+    "cloth": [{"mesh": {"type": "rectangle", "center": [0, 0.5, 0], "size": [0.4, 0.4], "resolution": [10, 10]},
+               "pin": {"corners": [0, 1, 2, 3]}}]
+  })");
+  int corner = -1;
+  for (int i = 0; i < scene.model.numCloth && corner < 0; ++i) corner = scene.model.clothPinned[size_t(i)] ? i : -1;
+  ASSERT_GE(corner, 0);
+  const Vec3 target = scene.state.particles.x[size_t(corner)] + Vec3(0.05f, 0.1f, 0);
+  scene.state.particles.x[size_t(corner)] = target;
+  runSteps(scene, 10);
+  EXPECT_EQ(scene.state.particles.x[size_t(corner)], target);
+  EXPECT_EQ(scene.state.particles.v[size_t(corner)], Vec3::Zero());
+}
