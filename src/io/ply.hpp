@@ -1,5 +1,5 @@
 // PLY output (binary little endian) for cloth and water, and a small reader for tests and tools.
-// Property names follow what Blender and Houdini import: x y z, nx ny nz.
+// Property names are the common ones (x y z, nx ny nz) that Houdini reads and Blender 3.4 reads the positions of.
 #pragma once
 #include <soak/model.hpp>
 #include <soak/state.hpp>
