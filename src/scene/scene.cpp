@@ -16,6 +16,7 @@
 #include "garment/stage.hpp"
 #include "pbd/tethers.hpp"
 #include "scene/chen_keys.hpp"
+#include "scene/clearance.hpp"
 #include "scene/cloth_keys.hpp"
 #include "scene/cloth_piece.hpp"
 #include "scene/common.hpp"
@@ -503,6 +504,7 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   });
   top.finish();
   checkSceneSize(log, top, cloth, model, scene.output, limit);
+  checkClothClearOfColliders(log, cloth, model.colliders);
   log.throwIfAny();
 
   buildCloth(model, cloth, file);
