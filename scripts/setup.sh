@@ -7,7 +7,10 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev
           libtinyobjloader-dev libgtest-dev libgmock-dev
-          libopenvdb-dev libboost-iostreams-dev zlib1g-dev povray ffmpeg)
+          libopenvdb-dev libboost-iostreams-dev zlib1g-dev povray ffmpeg
+          clang libclang-rt-14-dev libomp-14-dev)
+# clang, libclang-rt-14-dev (libFuzzer, the sanitizers) and libomp-14-dev (clang's OpenMP): the fuzz
+# targets of tests/fuzz/, built by scripts/fuzz.sh
 # zlib1g-dev: OpenVDB's CMake module (FindOpenVDB.cmake) requires ZLIB but its package does not depend on it
 missing=()
 for p in "${packages[@]}"; do
