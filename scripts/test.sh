@@ -2,10 +2,13 @@
 # installs what is missing, builds, and runs the whole test suite: once as built for this machine's
 # CPU (build/), once built without -march=native (build-portable/), so the scalar code paths that an
 # AVX-512 machine never takes (neighbour search, coupling walk, PBF pair sums) are compiled and tested
-# too. SOAK_SKIP_PORTABLE=1 skips the second build.
+# too. SOAK_SKIP_PORTABLE=1 skips the second build. The libFuzzer targets are built with clang in
+# build-fuzz/ (scripts/fuzz.sh), and the suite runs each for a few seconds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
+# the fuzz targets are built before the suite, which runs them briefly (77: clang's fuzzer runtime missing)
+./scripts/fuzz.sh --build || [[ $? -eq 77 ]]
 ctest --test-dir build --output-on-failure -j "$(nproc)"
 if [[ "${SOAK_SKIP_PORTABLE:-0}" != 1 ]]; then
   cmake -S . -B build-portable -G Ninja -DCMAKE_BUILD_TYPE=Release -DSOAK_NATIVE=OFF

@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include <soak/error.hpp>
+#include <soak/threads.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -34,7 +35,8 @@ int realMain(int argc, char** argv) {
       ->required();
   runCmd->add_option("--frames", run.frames, "frames to write after frame 0 (default: the scene's output.frames)")
       ->check(CLI::NonNegativeNumber);
-  runCmd->add_option("--threads", run.threads, "worker threads (default: all cores)")->check(CLI::PositiveNumber);
+  runCmd->add_option("--threads", run.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(1, soak::kMaxThreads));
   runCmd->add_option("--set", run.overrides, "override a scene value, key=value (repeatable)")
       ->check(checkOverride)
       ->allow_extra_args(false)
@@ -79,7 +81,7 @@ int realMain(int argc, char** argv) {
       ->excludes(stepsOpt)
       ->excludes(warmupOpt);
   benchCmd->add_option("--threads", bench.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, soak::kMaxThreads));
   benchCmd->add_option("--json", bench.json, "also write the results to this JSON file");
   benchCmd->add_option("--manifest", bench.manifest, "benchmark list (default: bench/benchmarks.json)");
   benchCmd->add_option("--set", bench.overrides, "override a value in every scene, key=value (repeatable)")

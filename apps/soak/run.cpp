@@ -99,6 +99,29 @@ int runCommand(const RunOptions& o) {
   return kExitOk;
 }
 
+namespace {
+
+std::string fmtPoint(const Vec3& v) { return fmt::format("[{:g}, {:g}, {:g}]", v.x(), v.y(), v.z()); }
+
+// one emitter by its kind: "block of [..] to [..] m at t = 0 s", "jet of radius ...", "rain of ..."
+std::string emitterSummary(const Emitter& e) {
+  const auto span = [&] {
+    return e.end < 1e29f ? fmt::format("t = {:g}..{:g} s", e.start, e.end) : fmt::format("from t = {:g} s", e.start);
+  };
+  switch (e.kind) {
+    case EmitterKind::Block:
+      return fmt::format("block of {} to {} m at t = {:g} s", fmtPoint(e.boxMin), fmtPoint(e.boxMax), e.start);
+    case EmitterKind::Jet:
+      return fmt::format("jet of radius {:g} m at {:g} m/s, {}", e.radius, e.speed, span());
+    case EmitterKind::Rain:
+      return fmt::format("rain of {:g} drops/(s m^2) over {:g} x {:g} m at {:g} m/s, {}", e.rate,
+                         2.0f * e.halfExtents.x(), 2.0f * e.halfExtents.z(), e.dropSpeed, span());
+  }
+  return "emitter";
+}
+
+}  // namespace
+
 int validateCommand(const ValidateOptions& o) {
   const Scene scene = loadScene(o.scene, o.overrides);
   const Model& m = scene.model;
@@ -120,14 +143,7 @@ int validateCommand(const ValidateOptions& o) {
   std::printf("  colliders:   %zu\n", m.colliders.size());
   for (const Collider& c : m.colliders) std::printf("    %s\n", c.name.c_str());
   std::printf("  emitters:    %zu\n", m.emitters.size());
-  for (const Emitter& e : m.emitters) {
-    if (e.kind == EmitterKind::Block)
-      std::printf("    %-12s block at t = %g s\n", e.name.c_str(), static_cast<double>(e.start));
-    else
-      std::printf("    %-12s jet of radius %g m at %g m/s, t = %g..%g s\n", e.name.c_str(),
-                  static_cast<double>(e.radius), static_cast<double>(e.speed), static_cast<double>(e.start),
-                  static_cast<double>(e.end));
-  }
+  for (const Emitter& e : m.emitters) std::printf("    %-12s %s\n", e.name.c_str(), emitterSummary(e).c_str());
   std::printf("  dt:          %g s, %d substeps\n", static_cast<double>(s.dt), s.substeps);
   const std::string upTo = s.fluidMaxIterations > s.fluidIterations
                                ? fmt::format(" (up to {} to a {:g} mean compression)", s.fluidMaxIterations, s.fluidTolerance)

@@ -1,5 +1,6 @@
 #include "io/obj.hpp"
 
+#include "core/text.hpp"
 #include "io/file.hpp"
 
 #include <fmt/format.h>
@@ -62,7 +63,8 @@ void writeClothObj(const std::string& path, const Model& model, const State& sta
                  model.triangles.size(), model.pieces.size());
   const auto& x = state.particles.x;
   for (const ClothPiece& piece : model.pieces) {
-    fmt::format_to(std::back_inserter(buf), "o {}\n", piece.name.empty() ? "cloth" : piece.name);
+    // the name escaped: a newline in it would start lines of geometry of its own
+    fmt::format_to(std::back_inserter(buf), "o {}\n", piece.name.empty() ? "cloth" : printableText(piece.name));
     const int end = piece.firstParticle + piece.particleCount;
     for (int i = piece.firstParticle; i < end; ++i) {
       if (vertexColor.empty())

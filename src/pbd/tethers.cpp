@@ -22,7 +22,9 @@ void pathLengths(const Model& model, int source, std::vector<float>& dist) {
   dist[source] = 0.0f;
   queue.push({0.0f, source});
   while (!queue.empty()) {
-    const auto [d, i] = queue.top();
+    // not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda below
+    const float d = queue.top().first;
+    const int i = queue.top().second;
     queue.pop();
     if (d > dist[i]) continue;
     const auto relax = [&](int j) {

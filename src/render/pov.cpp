@@ -1,6 +1,7 @@
 // POV-Ray scene text of one frame (docs/rendering.md)
 #include "render/pov.hpp"
 
+#include "core/text.hpp"
 #include "wetting/wetting.hpp"
 
 #include <fmt/format.h>
@@ -92,7 +93,8 @@ void box(Buf& b, const Vec3& centre, const Vec3& half) {
 }
 
 void collider(Buf& b, const Collider& c, const ColliderPose& pose, const SurfaceMesh* mesh) {
-  fmt::format_to(std::back_inserter(b), "// collider {}\n", c.name);
+  // names escaped: a newline would end the comment and POV-Ray would run the rest
+  fmt::format_to(std::back_inserter(b), "// collider {}\n", printableText(c.name));
   switch (c.shape) {
     case ColliderShape::Mesh:
       // the zero level of its distance grid, meshed once (render.cpp), in the local frame
@@ -266,7 +268,7 @@ std::string povScene(const PovFrameInput& in) {
   Buf b;
   const CameraSpec& cam = in.camera;
   const float aspect = static_cast<float>(in.width) / static_cast<float>(in.height);
-  fmt::format_to(std::back_inserter(b), "// soak frame: {}\n#version 3.7;\n", in.title);
+  fmt::format_to(std::back_inserter(b), "// soak frame: {}\n#version 3.7;\n", printableText(in.title));
   b.append(
       std::string_view("global_settings { assumed_gamma 1.0 max_trace_level 12 ambient_light rgb <1,1,1> }\n"
                        "#declare ClothFinish = finish { ambient 0.12 diffuse 0.8 specular 0.08 roughness 0.05 }\n"

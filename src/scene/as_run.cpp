@@ -2,6 +2,7 @@
 #include <soak/output.hpp>
 #include <soak/scene.hpp>
 
+#include "scene/limits.hpp"
 #include "scene/overrides.hpp"
 
 #include <filesystem>
@@ -31,10 +32,10 @@ void resolvePaths(nlohmann::json& v, const fs::path& baseDir) {
 }  // namespace
 
 std::string sceneAsRun(const std::string& path, const std::vector<std::string>& overrides) {
-  nlohmann::json doc = parseSceneJson(readTextFile(path), path);
+  nlohmann::json doc = parseSceneJson(readSceneText(path), path);
   applyOverrides(doc, overrides, path);
   resolvePaths(doc, fs::absolute(path).parent_path());
-  return doc.dump(2) + "\n";
+  return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace soak

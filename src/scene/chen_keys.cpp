@@ -6,6 +6,7 @@
 #include "garment/implicit.hpp"
 #include "garment/saturation_mass.hpp"
 #include "scene/common.hpp"
+#include "scene/limits.hpp"
 #include "world/garment_mesh.hpp"
 #include "world/mesh_sdf.hpp"
 
@@ -96,7 +97,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   ray.finish();
   ObjectReader cg = r.object("cg");
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());
-  g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::atLeast(1));
+  g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));
   cg.finish();
   ObjectReader w = r.object("wrinkles");
   g.wrinkles.enabled = w.boolean("enabled", w.present());
@@ -119,7 +120,7 @@ std::vector<Collider> readMannequin(ObjectReader& r, const std::string& name, Bo
   const size_t errorsBefore = log.messages().size();
   MannequinParams m;
   const MannequinParams d;
-  m.height = r.number("height", d.height, Range::positive());
+  m.height = r.number("height", d.height, Range{0.0, kMaxMannequinHeight, true, false});
   m.position = r.vec3("position", d.position);
   m.yaw = r.number("yaw", 0.0f) * kDeg;
   const float friction = r.number("friction", 0.5f, Range::unit());
@@ -197,7 +198,8 @@ std::optional<TriangleMesh> readGarmentMesh(ObjectReader& r, const Bodies& bodie
   const int style = r.choice("style", {"tshirt", "dress"}, std::string("tshirt"));
   g.style = style == 1 ? GarmentStyle::Dress : GarmentStyle::TShirt;
   const std::string body = r.string("body", std::nullopt);
-  g.edgeLength = r.number("edgeLength", d.edgeLength, Range::positive());
+  // the lattice has about (body size / edgeLength)^2 vertices: bounded before it is built
+  g.edgeLength = r.number("edgeLength", d.edgeLength, Range::atLeast(kMinGarmentEdgeLength));
   g.margin = r.number("margin", d.margin, Range::nonNegative());
   g.ease = r.number("ease", d.ease, Range::nonNegative());
   g.hem = r.number("hem", d.hem, Range{0.0, 1.0, false, true});
@@ -212,6 +214,13 @@ std::optional<TriangleMesh> readGarmentMesh(ObjectReader& r, const Bodies& bodie
                                             names.empty() ? "the scene has none" : "known: " + joinNames(names), body));
   }
   if (log.messages().size() != errorsBefore || it == bodies.end()) return std::nullopt;
+  // the lattice spans the body: at most about 1000 edges along its height
+  if (double(g.edgeLength) < double(it->second.params.height) / kMaxGarmentEdgesPerHeight) {
+    log.error(r.pathOf("edgeLength"),
+              fmt::format("expected a number >= the mannequin's height / {:g} = {:.4g} m, got {}", kMaxGarmentEdgesPerHeight,
+                          double(it->second.params.height) / kMaxGarmentEdgesPerHeight, g.edgeLength));
+    return std::nullopt;
+  }
   try {
     const BodySpec& b = it->second;
     Garment garment = buildGarment(b.params, poseAt(b.params, b.keys, 0.0), g, r.path());

@@ -61,7 +61,7 @@ const std::vector<std::string> kRectangleKeys = {"center", "size", "resolution",
 const std::vector<std::string> kObjKeys = {"path", "scale", "translate", "rotate"};
 
 // reads "mesh" and builds the triangle mesh; nullopt when it is invalid (errors logged)
-std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir, int maxVertices,
+std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir, const ParticleLimit& limit,
                                      std::optional<RectangleInfo>& rect, const Bodies& bodies,
                                      std::vector<int>& panelOfVertex) {
   ErrorLog& log = m.log();
@@ -70,8 +70,8 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
   if (type == 2) {
     std::optional<TriangleMesh> mesh = readGarmentMesh(m, bodies, panelOfVertex);
     m.finish(concat(kRectangleKeys, kObjKeys), "a garment mesh");
-    if (mesh && int64_t(mesh->vertices.size()) > maxVertices) {
-      log.error(m.path(), fmt::format("expected at most solver.maxParticles ({}) vertices, got {}", maxVertices,
+    if (mesh && int64_t(mesh->vertices.size()) > limit.count) {
+      log.error(m.path(), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
                                       mesh->vertices.size()));
       return std::nullopt;
     }
@@ -88,9 +88,9 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
       log.error(m.pathOf("axisV"), fmt::format("expected a direction perpendicular to axisU {}, got {}", fmtVec(u),
                                                fmtVec(v)));
     if (log.messages().size() != errorsBefore) return std::nullopt;
-    if (int64_t(res[0]) * res[1] > maxVertices) {
-      log.error(m.pathOf("resolution"), fmt::format("expected at most solver.maxParticles ({}) vertices, got {} x {}",
-                                                    maxVertices, res[0], res[1]));
+    if (int64_t(res[0]) * res[1] > limit.count) {
+      log.error(m.pathOf("resolution"), fmt::format("expected at most {} vertices ({}), got {} x {}", limit.count,
+                                                    limit.why, res[0], res[1]));
       return std::nullopt;
     }
     RectangleInfo info;
@@ -117,9 +117,9 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
       TriangleMesh mesh = loadObjMesh(resolved.string());
       // scale, then rotate, then translate
       for (Vec3& x : mesh.vertices) x = rotate * (scale * x) + translate;
-      if (int64_t(mesh.vertices.size()) > maxVertices) {
-        log.error(m.pathOf("path"), fmt::format("expected at most solver.maxParticles ({}) vertices, got {}",
-                                                maxVertices, mesh.vertices.size()));
+      if (int64_t(mesh.vertices.size()) > limit.count) {
+        log.error(m.pathOf("path"), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
+                                                mesh.vertices.size()));
         return std::nullopt;
       }
       return mesh;
@@ -181,7 +181,7 @@ std::vector<int> readPins(ObjectReader p, const TriangleMesh* mesh, const std::o
 }  // namespace
 
 std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::string& path, int index,
-                                   const std::string& baseDir, int maxVertices, bool shaoWetting, const Bodies& bodies,
+                                   const std::string& baseDir, const ParticleLimit& limit, bool shaoWetting, const Bodies& bodies,
                                    const std::vector<Collider>& colliders) {
   if (!v.is_object()) {
     log.expected(path, "an object (a cloth piece)", v);
@@ -190,11 +190,11 @@ std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::stri
   ObjectReader r(log, &v, path);
   ClothSpec spec;
   spec.path = path;
-  spec.name = r.string("name", fmt::format("cloth{}", index));
+  spec.name = r.name("name", fmt::format("cloth{}", index));
   const ClothSolver solver = readClothSolver(r);
   std::optional<RectangleInfo> rect;
   std::optional<TriangleMesh> mesh =
-      readMesh(r.object("mesh", true), baseDir, maxVertices, rect, bodies, spec.panelOfVertex);
+      readMesh(r.object("mesh", true), baseDir, limit, rect, bodies, spec.panelOfVertex);
   spec.material = readMaterial(r.object("material"), solver);
   spec.pinned = readPins(r.object("pin"), mesh ? &*mesh : nullptr, rect);
   spec.chen = readChenCloth(r, solver, shaoWetting);

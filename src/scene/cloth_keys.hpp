@@ -4,6 +4,7 @@
 #include <soak/model.hpp>
 
 #include "scene/chen_keys.hpp"
+#include "scene/limits.hpp"
 #include "scene/reader.hpp"
 #include "world/mesh.hpp"
 
@@ -25,10 +26,10 @@ struct ClothSpec {
 };
 
 // reads cloth[index] (v, at JSON path `path`); nullopt when it is invalid (errors logged). Meshes
-// have at most maxVertices vertices; a garment is sewn around a mannequin of `bodies`, and a piece
+// have at most limit.count vertices; a garment is sewn around a mannequin of `bodies`, and a piece
 // with a "body" is checked against (or pushed out of) the colliders
 std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::string& path, int index,
-                                   const std::string& baseDir, int maxVertices, bool shaoWetting, const Bodies& bodies,
+                                   const std::string& baseDir, const ParticleLimit& limit, bool shaoWetting, const Bodies& bodies,
                                    const std::vector<Collider>& colliders);
 
 }  // namespace soak

@@ -1,5 +1,7 @@
 #include "scene/overrides.hpp"
 
+#include "scene/limits.hpp"
+
 #include <soak/error.hpp>
 
 #include <fmt/format.h>
@@ -51,10 +53,11 @@ struct DuplicateKeys {
   std::vector<Frame> frames;
   std::string duplicate;    // the JSON path of the first repeated key, empty if none
 
-  std::string path() const {
+  // `pending`: the innermost array's next element is the one being read (a value that failed to parse)
+  std::string path(bool pending = false) const {
     std::string out;
     for (const Frame& f : frames) {
-      if (f.array) out += fmt::format("[{}]", f.index - 1);
+      if (f.array) out += fmt::format("[{}]", f.index - (pending && &f == &frames.back() ? 0 : 1));
       else if (!f.key.empty()) out += (out.empty() ? "" : ".") + f.key;
     }
     return out;
@@ -90,10 +93,18 @@ struct DuplicateKeys {
 }  // namespace
 
 Json parseSceneJson(const std::string& text, const std::string& file) {
+  checkJsonText(text, file);
   DuplicateKeys keys;
   Json doc;
   try {
     doc = Json::parse(text, std::ref(keys), true, true);
+  } catch (const Json::out_of_range& e) {
+    // a number beyond double range (1e400): the parser stops at it, the key being read names it
+    const std::string what = e.what();
+    const size_t token = what.find("parsing ");
+    throw errorAt(file, keys.path(true).empty() ? "(top level)" : keys.path(true),
+                  "expected a number within double range (about 1.8e308), got " +
+                      (token == std::string::npos ? what : what.substr(token + 8)));
   } catch (const Json::parse_error& e) {
     // e.byte is the 1-based offset of the offending character; count lines up to it ourselves
     const size_t end = std::min(text.size(), e.byte > 0 ? size_t(e.byte - 1) : size_t(0));
@@ -145,8 +156,11 @@ void applyOverrides(Json& doc, const std::vector<std::string>& overrides, const 
       }
       walked += (walked.empty() ? "" : ".") + part;
     }
+    checkJsonText(valueText, file + ": override '" + text + "'");
     try {
       *cur = Json::parse(valueText);
+    } catch (const Json::out_of_range&) {
+      throw fail("expected a number within double range (about 1.8e308), got " + valueText);
     } catch (const Json::parse_error&) {
       *cur = valueText;  // not JSON: a bare string such as a file name
     }

@@ -1,5 +1,7 @@
 #include "scene/reader.hpp"
 
+#include "scene/limits.hpp"
+
 #include <soak/error.hpp>
 
 #include <fmt/format.h>
@@ -66,15 +68,23 @@ std::string describeJson(const Json& v) {
   if (v.is_string()) {
     std::string s = v.get<std::string>();
     if (s.size() > 40) s = s.substr(0, 37) + "...";
-    return "the string \"" + s + "\"";
+    // control characters shown as \xNN: a message must not carry a newline or a terminal escape
+    std::string shown;
+    for (const char c : s)
+      shown += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? fmt::format("\\x{:02x}", static_cast<unsigned char>(c))
+                                                                   : std::string(1, c);
+    return "the string \"" + shown + "\"";
   }
   if (v.is_object()) return v.empty() ? "an empty object" : "an object";
+  // dumped only when small: a long array is not printed whole, and invalid UTF-8 (a string given
+  // by an override) is replaced instead of throwing
   if (v.is_array()) {
-    const std::string d = v.dump();
-    if (d.size() <= 40) return d;
+    const bool small = v.size() <= 8 && std::all_of(v.begin(), v.end(), [](const Json& e) { return e.is_primitive(); });
+    const std::string d = small ? v.dump(-1, ' ', false, Json::error_handler_t::replace) : std::string();
+    if (!d.empty() && d.size() <= 40) return d;
     return fmt::format("an array of {} elements", v.size());
   }
-  return v.dump();  // null, true, false, numbers
+  return v.dump(-1, ' ', false, Json::error_handler_t::replace);  // null, true, false, numbers
 }
 
 std::string joinPath(const std::string& parent, const std::string& key) {
@@ -185,6 +195,19 @@ std::string ObjectReader::string(const std::string& key, std::optional<std::stri
     return def.value_or("");
   }
   return v->get<std::string>();
+}
+
+std::string ObjectReader::name(const std::string& key, std::optional<std::string> def) {
+  const bool given = has(key);
+  std::string s = string(key, def);
+  if (!given) return s;
+  if (const std::string problem = nameProblem(s); !problem.empty()) {
+    log_.error(pathOf(key), fmt::format("expected a name of 1 to {} printable ASCII characters (no newline, tab or "
+                                        "other control character), got {}",
+                                        kMaxNameLength, problem));
+    return def.value_or("");
+  }
+  return s;
 }
 
 Vec3 ObjectReader::vec3(const std::string& key, std::optional<Vec3> def, Range range) {

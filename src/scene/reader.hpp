@@ -79,6 +79,9 @@ class ObjectReader {
   int integer(const std::string& key, std::optional<int> def, Range range = Range::any());
   bool boolean(const std::string& key, std::optional<bool> def);
   std::string string(const std::string& key, std::optional<std::string> def);
+  // a name (scene, cloth, collider, emitter): a string of 1 to 256 printable ASCII characters, since
+  // names are written into comments of the output files and POV-Ray scenes
+  std::string name(const std::string& key, std::optional<std::string> def);
   Vec3 vec3(const std::string& key, std::optional<Vec3> def, Range range = Range::any());
   // a direction: any non-zero vec3, returned normalised
   Vec3 unitVec3(const std::string& key, std::optional<Vec3> def);

@@ -16,9 +16,11 @@
 #include "garment/stage.hpp"
 #include "pbd/tethers.hpp"
 #include "scene/chen_keys.hpp"
+#include "scene/clearance.hpp"
 #include "scene/cloth_keys.hpp"
 #include "scene/cloth_piece.hpp"
 #include "scene/common.hpp"
+#include "scene/limits.hpp"
 #include "scene/overrides.hpp"
 #include "scene/reader.hpp"
 #include "wetting/wetting.hpp"
@@ -91,17 +93,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void readSolver(ObjectReader r, SolverParams& s) {
+void readSolver(ObjectReader r, SolverParams& s, float& maxMemoryGB) {
   const SolverParams d;
   s.dt = r.number("dt", d.dt, Range::positive());
-  s.substeps = r.integer("substeps", d.substeps, Range::atLeast(1));
-  s.fluidIterations = r.integer("fluidIterations", d.fluidIterations, Range::atLeast(1));
+  // loop counts of a step are bounded (kMaxLoopCount): a mistyped 1e9 would hang the first step
+  const Range loops = Range::between(1, kMaxLoopCount), loops0 = Range::between(0, kMaxLoopCount);
+  s.substeps = r.integer("substeps", d.substeps, loops);
+  s.fluidIterations = r.integer("fluidIterations", d.fluidIterations, loops);
   s.fluidMaxIterations = r.integer("fluidMaxIterations", std::max(d.fluidMaxIterations, s.fluidIterations),
-                                   Range::atLeast(s.fluidIterations));
+                                   Range::between(s.fluidIterations, std::max(s.fluidIterations, kMaxLoopCount)));
   s.fluidTolerance = r.number("fluidTolerance", d.fluidTolerance, Range::positive());
-  s.clothSubsteps = r.integer("clothSubsteps", d.clothSubsteps, Range::atLeast(1));
-  s.clothIterations = r.integer("clothIterations", d.clothIterations, Range::atLeast(0));
-  s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, Range::atLeast(0));
+  s.clothSubsteps = r.integer("clothSubsteps", d.clothSubsteps, loops);
+  s.clothIterations = r.integer("clothIterations", d.clothIterations, loops0);
+  s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, loops0);
   s.gravity = r.vec3("gravity", d.gravity);
   ObjectReader dom = r.object("domain");
   s.domainMin = dom.vec3("min", d.domainMin);
@@ -110,6 +114,7 @@ void readSolver(ObjectReader r, SolverParams& s) {
   checkOrdered(r.log(), dom.pathOf("max"), "solver.domain.min", s.domainMin, s.domainMax);
   s.maxParticles = r.integer("maxParticles", d.maxParticles, Range::atLeast(1));
   s.maxSpeed = r.number("maxSpeed", d.maxSpeed, Range::positive());
+  maxMemoryGB = r.number("maxMemoryGB", 0.0f, Range::positive());
   r.finish();
 }
 
@@ -118,9 +123,12 @@ void readWater(ObjectReader r, WaterParams& w) {
   w.restDensity = r.number("restDensity", d.restDensity, Range::positive());
   w.spacing = r.number("spacing", d.spacing, Range::positive());
   w.supportRadius = r.number("supportRadius", d.supportRadius, Range::positive());
-  if (!(w.supportRadius > w.spacing))
+  // above the spacing, and at most kMaxSupportRatio spacings: the lattice sums of the emitters visit
+  // (2 h / spacing + 1)^3 sites and the neighbour lists grow as (h / spacing)^3
+  if (!(w.supportRadius > w.spacing) || !(double(w.supportRadius) <= kMaxSupportRatio * double(w.spacing)))
     r.log().error(r.pathOf("supportRadius"),
-                  fmt::format("expected a number > water.spacing ({}), got {}", w.spacing, w.supportRadius));
+                  fmt::format("expected a number in (water.spacing, {:g} x water.spacing] = ({}, {:g}], got {}",
+                              kMaxSupportRatio, w.spacing, kMaxSupportRatio * double(w.spacing), w.supportRadius));
   w.particleMass = r.number("particleMass", d.particleMass, Range::positive());
   w.relaxation = r.number("relaxation", d.relaxation, Range::positive());
   w.viscosity = r.number("viscosity", d.viscosity, Range::unit());
@@ -138,7 +146,7 @@ void readWater(ObjectReader r, WaterParams& w) {
 void readOutput(ObjectReader r, OutputSettings& o) {
   const OutputSettings d;
   o.frames = r.integer("frames", d.frames, Range::atLeast(1));
-  o.stepsPerFrame = r.integer("stepsPerFrame", d.stepsPerFrame, Range::atLeast(1));
+  o.stepsPerFrame = r.integer("stepsPerFrame", d.stepsPerFrame, Range::between(1, kMaxStepsPerFrame));
   o.clothObj = r.boolean("clothObj", d.clothObj);
   o.clothPly = r.boolean("clothPly", d.clothPly);
   o.water = r.boolean("water", d.water);
@@ -198,7 +206,7 @@ void readWetting(ObjectReader r, WettingParams& w) {
   w.diffusivity = f.number("diffusivity", d.diffusivity, Range::nonNegative());
   w.wickingHeight = f.number("wickingHeight", d.wickingHeight, Range::positive());
   w.diffusionGravityFactor = f.number("gravityInfluence", d.diffusionGravityFactor, Range::unit());
-  w.diffusionIterations = f.integer("iterations", d.diffusionIterations, Range::atLeast(1));
+  w.diffusionIterations = f.integer("iterations", d.diffusionIterations, Range::between(1, kMaxLoopCount));
   f.finish();
   ObjectReader e = r.object("emission");
   w.emission = e.boolean("enabled", d.emission);
@@ -257,7 +265,7 @@ std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, 
   }
   ObjectReader r(log, &v, path);
   Collider c;
-  c.name = r.string("name", fmt::format("collider{}", index));
+  c.name = r.name("name", fmt::format("collider{}", index));
   const int type = r.choice("type", kColliderTypes, std::nullopt);
   if (type < 0) return std::nullopt;  // keys depend on the type: nothing more to check
   if (kColliderTypes[size_t(type)] == "mannequin") {
@@ -318,7 +326,7 @@ bool insideDomain(const SolverParams& s, const Vec3& p) {
 }
 
 std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::string& path, int index,
-                                   const SolverParams& solver) {
+                                   const SolverParams& solver, const WaterParams& water) {
   if (!v.is_object()) {
     log.expected(path, "an object (an emitter)", v);
     return std::nullopt;
@@ -326,7 +334,7 @@ std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::stri
   ObjectReader r(log, &v, path);
   Emitter e;
   const Emitter d;
-  e.name = r.string("name", fmt::format("emitter{}", index));
+  e.name = r.name("name", fmt::format("emitter{}", index));
   const int type = r.choice("type", {"block", "jet", "rain"}, std::nullopt);
   if (type < 0) return std::nullopt;
   e.kind = EmitterKind(type);
@@ -346,6 +354,14 @@ std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::stri
   } else if (e.kind == EmitterKind::Rain) {
     readRain(r, e);
     r.finish(concat(kBlockKeys, kJetKeys), "a rain emitter");
+    if (e.dropSpeed > solver.maxSpeed)
+      log.error(r.pathOf("dropSpeed"), fmt::format("expected a number <= solver.maxSpeed ({} m/s), got {}",
+                                                   solver.maxSpeed, e.dropSpeed));
+    const double perSecond = double(e.rate) * 4.0 * double(e.halfExtents.x()) * double(e.halfExtents.z());
+    if (perSecond > kMaxDropsPerSecond)
+      log.error(r.pathOf("rate"), fmt::format("expected at most {:g} drops a second over the rectangle (rate x area), "
+                                              "got {:.4g}",
+                                              kMaxDropsPerSecond, perSecond));
     if (r.has("origin") && !insideDomain(solver, e.origin))
       log.error(r.pathOf("origin"), fmt::format("expected a point {}, got {}", domain, fmtVec(e.origin)));
   } else {
@@ -356,6 +372,15 @@ std::optional<Emitter> readEmitter(ErrorLog& log, const Json& v, const std::stri
     e.start = r.number("start", d.start, Range::nonNegative());
     e.end = r.number("end", d.end, Range::positive());
     r.finish(concat(kBlockKeys, kRainKeys), "a jet emitter");
+    // water faster than solver.maxSpeed stops the run as diverged at its first frame
+    if (e.speed > solver.maxSpeed)
+      log.error(r.pathOf("speed"), fmt::format("expected a number <= solver.maxSpeed ({} m/s), got {}",
+                                               solver.maxSpeed, e.speed));
+    // a disc is a lattice of (2 radius / spacing)^2 sites: bounded so the count fits and a step ends
+    if (double(e.radius) > kMaxJetRadiusRatio * double(water.spacing))
+      log.error(r.pathOf("radius"), fmt::format("expected a number <= {:g} x water.spacing = {:g} m, got {}",
+                                                kMaxJetRadiusRatio, kMaxJetRadiusRatio * double(water.spacing),
+                                                e.radius));
     if (r.has("end") && !(e.end > e.start))
       log.error(r.pathOf("end"), fmt::format("expected a time > start ({} s), got {}", e.start, e.end));
     if (r.has("origin") && !insideDomain(solver, e.origin))
@@ -374,18 +399,31 @@ std::vector<T> readArray(ObjectReader& top, const std::string& key, F&& readOne)
   return out;
 }
 
-// the scene needs something to simulate, and its cloth fits in solver.maxParticles
-void checkSceneSize(ErrorLog& log, ObjectReader& top, const std::vector<ClothSpec>& cloth, int maxVertices) {
+// the scene needs something to simulate, and its particles fit in the limit (solver.maxParticles and
+// the memory budget): the cloth, and the water its emitters can make over the scene's frames
+void checkSceneSize(ErrorLog& log, ObjectReader& top, const std::vector<ClothSpec>& cloth, const Model& model,
+                    const OutputSettings& output, const ParticleLimit& limit) {
   const Json* clothJson = top.get("cloth");
   const Json* emitterJson = top.get("emitters");
   const bool noCloth = !clothJson || !clothJson->is_array() || clothJson->empty();
   const bool noEmitter = !emitterJson || !emitterJson->is_array() || emitterJson->empty();
   if (noCloth && noEmitter) log.error("", "expected at least one cloth piece or emitter, got none (empty scene)");
-  size_t clothParticles = 0;
-  for (const ClothSpec& c : cloth) clothParticles += c.mesh.vertices.size();
-  if (clothParticles > size_t(maxVertices))
-    log.error("cloth", fmt::format("expected at most solver.maxParticles ({}) cloth particles in all, got {}",
-                                   maxVertices, clothParticles));
+  int64_t clothParticles = 0;
+  for (const ClothSpec& c : cloth) clothParticles += int64_t(c.mesh.vertices.size());
+  if (clothParticles > limit.count) {
+    log.error("cloth", fmt::format("expected at most {} cloth particles in all ({}), got {}", limit.count, limit.why,
+                                   clothParticles));
+    return;
+  }
+  // emitters stop quietly at solver.maxParticles; only a memory budget below it can be exceeded
+  const double duration = double(model.solver.dt) * output.stepsPerFrame * output.frames;
+  const int64_t water = emitterParticleBound(model, duration);
+  const int64_t total = std::min<int64_t>(clothParticles + water, model.solver.maxParticles);
+  if (total > limit.count)
+    log.error("emitters", fmt::format("expected at most {} particles in all ({}), got up to {} ({} cloth and up to "
+                                      "{} water from the emitters in the scene's {:.4g} s; lower "
+                                      "solver.maxParticles to cap them)",
+                                      limit.count, limit.why, total, clothParticles, water, duration));
 }
 
 // appends the validated pieces with their Chen 2012 settings, then the tethers and the springs of the
@@ -443,27 +481,30 @@ Scene buildScene(Json doc, const std::string& file, const std::string& baseDir,
   scene.path = file;
   Model& model = scene.model;
   ObjectReader top(log, &doc, "");
-  scene.name = top.string("name", fs::path(file).stem().string());
+  scene.name = top.name("name", fs::path(file).stem().string());
   scene.description = top.string("description", "");
-  readSolver(top.object("solver"), model.solver);
+  float maxMemoryGB = 0.0f;  // 0: the machine's available memory
+  readSolver(top.object("solver"), model.solver, maxMemoryGB);
   readWater(top.object("water"), model.water);
   readOutput(top.object("output"), scene.output);
   readView(top.object("view"), scene.view);
   readWetting(top.object("wetting"), model.wetting);
-  const int maxVertices = model.solver.maxParticles;
+  // the memory budget is known before any mesh is built: a rectangle's resolution is checked against it
+  const ParticleLimit limit = particleLimit(model.solver.maxParticles, maxMemoryGB);
   Bodies bodies;  // mannequins by name, for the garments sewn around them
   for (auto& group : readArray<std::vector<Collider>>(top, "colliders", [&](const Json& v, const std::string& p, int i) {
          return readCollider(log, v, p, i, baseDir, bodies);
        }))
     for (Collider& c : group) model.colliders.push_back(std::move(c));
   const std::vector<ClothSpec> cloth = readArray<ClothSpec>(top, "cloth", [&](const Json& v, const std::string& p, int i) {
-    return readCloth(log, v, p, i, baseDir, maxVertices, model.wetting.enabled, bodies, model.colliders);
+    return readCloth(log, v, p, i, baseDir, limit, model.wetting.enabled, bodies, model.colliders);
   });
   model.emitters = readArray<Emitter>(top, "emitters", [&](const Json& v, const std::string& p, int i) {
-    return readEmitter(log, v, p, i, model.solver);
+    return readEmitter(log, v, p, i, model.solver, model.water);
   });
   top.finish();
-  checkSceneSize(log, top, cloth, maxVertices);
+  checkSceneSize(log, top, cloth, model, scene.output, limit);
+  checkClothClearOfColliders(log, cloth, model.colliders);
   log.throwIfAny();
 
   buildCloth(model, cloth, file);
@@ -479,12 +520,9 @@ Scene loadSceneFromString(const std::string& text, const std::string& sourceName
 }
 
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw errorAt(path, "", "cannot open the scene file (expected a readable JSON file)");
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = readSceneText(path);
   const fs::path parent = fs::path(path).parent_path();
-  return loadSceneFromString(text.str(), path, parent.empty() ? fs::path(".").string() : parent.string(), overrides);
+  return loadSceneFromString(text, path, parent.empty() ? fs::path(".").string() : parent.string(), overrides);
 }
 
 }  // namespace soak

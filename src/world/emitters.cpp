@@ -27,7 +27,8 @@ int latticeCount(float lo, float hi, float s) {
   const double extent = static_cast<double>(hi) - static_cast<double>(lo);
   if (extent <= 0.0) return 0;
   // tolerance so that an extent of exactly n spacings in float gives n sites
-  return static_cast<int>(std::floor(extent / s + 1e-4));
+  // clamped: a tiny spacing must not overflow the count (the loops stop at solver.maxParticles)
+  return static_cast<int>(std::min(std::floor(extent / s + 1e-4), 2147483647.0));
 }
 
 size_t emitBlock(const Model& model, State& state, const Emitter& e) {

@@ -1,10 +1,18 @@
 // triangle meshes: OBJ reading, generated rectangles, edge lists and cloth mesh checks (mesh.hpp)
 #include "world/mesh.hpp"
 
+#include <soak/error.hpp>
+
+#include <fmt/format.h>
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
-#include <soak/error.hpp>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
 
 namespace soak {
 
@@ -15,7 +23,95 @@ std::string trimmed(std::string s) {
   return s;
 }
 
+// a token as an error message shows it: at most 40 characters, control bytes as '?'
+std::string shown(std::string_view token) {
+  std::string s(token.substr(0, 40));
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return "'" + s + (token.size() > 40 ? "...'" : "'");
+}
+
+std::vector<std::string_view> splitWords(std::string_view line) {
+  std::vector<std::string_view> words;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    const size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    if (i > start) words.push_back(line.substr(start, i - start));
+  }
+  return words;
+}
+
+// the whole token is a finite number (a leading '+' allowed)
+bool isFiniteNumber(std::string_view t) {
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return !t.empty() && ec == std::errc() && end == t.data() + t.size() && std::isfinite(v);
+}
+
+// a face corner: i, i/j, i//k or i/j/k, each a non-zero integer that fits in 32 bits (j may be empty)
+bool isFaceCorner(std::string_view t) {
+  int part = 0;
+  size_t start = 0;
+  for (size_t i = 0; i <= t.size(); ++i) {
+    if (i < t.size() && t[i] != '/') continue;
+    const std::string_view p = t.substr(start, i - start);
+    if (!(part == 1 && p.empty() && i < t.size())) {
+      int v = 0;
+      const auto [end, ec] = std::from_chars(p.data(), p.data() + p.size(), v);
+      if (p.empty() || ec != std::errc() || end != p.data() + p.size() || v == 0) return false;
+    }
+    ++part;
+    start = i + 1;
+  }
+  return part >= 1 && part <= 3;
+}
+
+// one v / vn / vt / f line's complaint, or "" when it is well formed
+std::string objLineProblem(const std::vector<std::string_view>& w) {
+  const std::string_view kind = w[0];
+  if (kind == "v" || kind == "vn" || kind == "vt") {
+    const size_t lo = kind == "vt" ? 1 : 3, hi = kind == "v" ? 6 : 3;
+    const std::string what = kind == "v"    ? "3 finite numbers (x y z, optionally w or r g b) after 'v'"
+                             : kind == "vn" ? "3 finite numbers after 'vn'"
+                                            : "1 to 3 finite numbers after 'vt'";
+    if (w.size() - 1 < lo || w.size() - 1 > hi || (kind == "v" && w.size() - 1 == 5))
+      return fmt::format("expected {}, got {} values", what, w.size() - 1);
+    for (size_t k = 1; k < w.size(); ++k)
+      if (!isFiniteNumber(w[k])) return fmt::format("expected {}, got {}", what, shown(w[k]));
+    return "";
+  }
+  if (kind == "f") {
+    if (w.size() < 4) return fmt::format("expected at least 3 vertices after 'f', got {}", w.size() - 1);
+    for (size_t k = 1; k < w.size(); ++k)
+      if (!isFaceCorner(w[k]))
+        return fmt::format("expected face vertices of non-zero integer indices (i, i/j, i//k or i/j/k) after 'f', "
+                           "got {}",
+                           shown(w[k]));
+  }
+  return "";
+}
+
 }  // namespace
+
+void checkObjText(const std::string& text, const std::string& source) {
+  size_t line = 0, begin = 0;
+  while (begin < text.size()) {
+    ++line;
+    size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    std::string_view l(text.data() + begin, end - begin);
+    begin = end + 1;
+    if (const size_t hash = l.find('#'); hash != std::string_view::npos) l = l.substr(0, hash);
+    while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.remove_suffix(1);
+    const std::vector<std::string_view> words = splitWords(l);
+    if (words.empty()) continue;
+    if (const std::string problem = objLineProblem(words); !problem.empty())
+      throw errorAt(source, fmt::format("line {}", line), problem);
+  }
+}
 
 std::vector<EdgeRef> collectEdges(const std::vector<std::array<int, 3>>& triangles) {
   std::vector<EdgeRef> edges;
@@ -83,11 +179,25 @@ void validateClothMesh(const std::string& name, const TriangleMesh& mesh, const 
 }
 
 TriangleMesh loadObjMesh(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxObjBytes)
+    throw errorAt(path, "", fmt::format("expected an OBJ file of at most {} MiB, got {} bytes", kMaxObjBytes >> 20, size));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw errorAt(path, "", "cannot read OBJ mesh: cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseObjMesh(text.str(), path);
+}
+
+TriangleMesh parseObjMesh(const std::string& text, const std::string& path) {
+  checkObjText(text, path);
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
+  config.mtl_search_path = "";
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
+  if (!reader.ParseFromString(text, "", config)) {
     const std::string msg = trimmed(reader.Error());
     throw errorAt(path, "", "cannot read OBJ mesh" + (msg.empty() ? std::string() : ": " + msg));
   }

@@ -15,8 +15,17 @@ struct TriangleMesh {
   std::vector<std::array<int, 3>> triangles;
 };
 
-// reads an OBJ file (triangulating polygons); throws soak::Error naming the file on failure
+// reads an OBJ file (triangulating polygons); throws soak::Error naming the file on failure, and
+// refuses a file larger than kMaxObjBytes before reading it
+inline constexpr size_t kMaxObjBytes = size_t(1) << 30;
 TriangleMesh loadObjMesh(const std::string& path);
+// the same from OBJ text; `source` names it in errors
+TriangleMesh parseObjMesh(const std::string& text, const std::string& source);
+// checks the numbers of OBJ text strictly before tinyobjloader, which reads "nan" or "abc" as 0:
+// every v, vn and vt line holds only finite numbers (v: 3, 4 with a weight or 6 with a colour), every f line at least
+// 3 vertices of non-zero integer indices (i, i/j, i//k, i/j/k). Throws soak::Error
+// "<source>: at line N: expected ..., got ..."
+void checkObjText(const std::string& text, const std::string& source);
 
 // a rectangle of size (width x height) m with (resX x resY) vertices, centred at `center`, lying in
 // the plane spanned by unit axes `axisU` (width) and `axisV` (height); alternating diagonals

@@ -151,6 +151,34 @@ TEST(CliValidate, SummaryCountsParticlesAndPieces) {
   EXPECT_NE(r.out.find("3 substeps"), std::string::npos) << r.out;
 }
 
+TEST(CliValidate, EmittersAreNamedByKind) {
+  const Cli cli("kinds");
+  std::string text = kTinyScene;
+  const std::string block = R"({"name": "cube", "type": "block")";
+  text.replace(text.find(block), block.size(),
+               R"({"name": "nozzle", "type": "jet", "origin": [0, 0.9, 0], "radius": 0.03, "end": 0.5},
+                  {"name": "shower", "type": "rain", "origin": [0, 0.9, 0], "halfExtents": [0.1, 0.1], "start": 0.1},
+                  {"name": "cube", "type": "block")");
+  const Result r = cli.run("validate '" + cli.writeScene("kinds.json", text) + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("nozzle       jet of radius 0.03 m at 4 m/s, t = 0..0.5 s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("shower       rain of 200 drops/(s m^2) over 0.2 x 0.2 m at 6.5 m/s, from t = 0.1 s"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("cube         block of [-0.04, 0.54, -0.04] to [0.04, 0.62, 0.04] m at t = 0 s"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST(CliRun, ThreadCountIsBounded) {
+  const Cli cli("threads");
+  const std::string scene = cli.writeScene("tiny.json", kTinyScene);
+  const Result r = cli.run("run '" + scene + "' -o '" + (cli.dir() / "out").string() + "' --threads 100000");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("--threads: Value 100000 not in range 1 to 1024"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(cli.dir() / "out"));
+}
+
 TEST(CliVersion, PrintsTheVersion) {
   const Cli cli("version");
   const Result r = cli.run("--version");

@@ -184,5 +184,24 @@ TEST(IoObj, AVertexWithoutAnAreaHasAZeroNormal) {
   for (int i = 3; i < 7; ++i) EXPECT_EQ(n[i], Vec3::Zero()) << i;
 }
 
+// a piece name that reached the writer with a newline (the loader refuses one) cannot add lines
+TEST(IoObj, PieceNamesAreEscapedNotTrusted) {
+  Fixture f = makeFixture();
+  f.model.pieces[0].name = "evil\nv 9 9 9\nf 1 2 3\\";
+  const fs::path dir = tempDir("obj_escape");
+  const std::string path = (dir / "cloth_0000.obj").string();
+  writeClothObj(path, f.model, f.state);
+  int v = 0, objects = 0;
+  std::string first;
+  for (const std::string& l : lines(readTextFile(path))) {
+    v += l.rfind("v ", 0) == 0 ? 1 : 0;
+    if (l.rfind("o ", 0) == 0 && objects++ == 0) first = l;
+  }
+  EXPECT_EQ(v, f.model.numCloth);
+  EXPECT_EQ(objects, 2);
+  EXPECT_EQ(first, "o evil\\x0av 9 9 9\\x0af 1 2 3\\\\");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace soak

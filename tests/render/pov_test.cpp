@@ -370,5 +370,21 @@ TEST(RenderPov, ClothColoursFromSaturationElseFromTheObj) {
   EXPECT_EQ(rampColor("green", -0.1f, 0.4f), Vec3(0, 1, 0));
 }
 
+// names from a scene reach the POV-Ray file only inside comments, escaped: a newline in one would
+// end the comment and POV-Ray would run what follows (#system, a #declare ...)
+TEST(RenderPov, NamesInCommentsAreEscaped) {
+  Scene scene = loadSceneFromString(kTinyScene, "tiny.json", ".");
+  scene.model.colliders[0].name = "floor\n#debug \"owned\"\r";
+  PovFrameInput in;
+  in.model = &scene.model;
+  for (const Collider& c : scene.model.colliders) in.poses.push_back(colliderPose(c, 0.0));
+  in.title = "tiny\n#include \"/etc/passwd\" frame 1";
+  const std::string pov = povScene(in);
+  EXPECT_EQ(pov.find("\n#debug"), std::string::npos);
+  EXPECT_EQ(pov.find("\n#include"), std::string::npos);
+  EXPECT_NE(pov.find("// collider floor\\x0a#debug \"owned\"\\x0d\n"), std::string::npos);
+  EXPECT_NE(pov.find("// soak frame: tiny\\x0a#include \"/etc/passwd\" frame 1\n"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace soak

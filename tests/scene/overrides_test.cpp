@@ -51,7 +51,7 @@ TEST(SceneOverrides, ChangeValuesBeforeValidation) {
   for (uint8_t p : s.model.clothPinned) pinned += p;
   EXPECT_EQ(pinned, 2);
   // an override is validated like the file itself
-  EXPECT_HAS(errorWith("solver.substeps=0"), "test.json: at solver.substeps: expected an integer >= 1, got 0");
+  EXPECT_HAS(errorWith("solver.substeps=0"), "test.json: at solver.substeps: expected an integer in [1, 1000], got 0");
 }
 
 TEST(SceneErrors, BadOverridesNameTheOverride) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 #include "support/mesh_checks.hpp"
@@ -77,6 +78,49 @@ TEST(MeshObj, MissingFileAndNoTrianglesAreNamed) {
   const std::string msg2 = errorOf([&] { loadObjMesh(f.path.string()); });
   EXPECT_NE(msg2.find(f.path.string()), std::string::npos) << msg2;
   EXPECT_NE(msg2.find("no triangles"), std::string::npos) << msg2;
+}
+
+// the OBJ's numbers are read strictly: tinyobjloader alone reads "nan" or "abc" as 0
+TEST(MeshObj, NumbersAreParsedStrictlyWithFileAndLine) {
+  const auto errorFor = [](const std::string& text) { return errorOf([&] { parseObjMesh(text, "cloth.obj"); }); };
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  EXPECT_EQ(errorFor("v 1 2 3\n" + tri + "v nan nan nan\nf 1 2 3\n"),
+            "cloth.obj: at line 5: expected 3 finite numbers (x y z, optionally w or r g b) after 'v', got 'nan'");
+  EXPECT_EQ(errorFor(tri + "v abc def ghi\nf 1 2 3\n"),
+            "cloth.obj: at line 4: expected 3 finite numbers (x y z, optionally w or r g b) after 'v', got 'abc'");
+  EXPECT_EQ(errorFor("v 1 2 inf\n"), "cloth.obj: at line 1: expected 3 finite numbers (x y z, optionally w or r g b) "
+                                      "after 'v', got 'inf'");
+  EXPECT_EQ(errorFor("v 1 2\n"), "cloth.obj: at line 1: expected 3 finite numbers (x y z, optionally w or r g b) after "
+                                  "'v', got 2 values");
+  EXPECT_EQ(errorFor("v 1.5e2 2x 3\n"), "cloth.obj: at line 1: expected 3 finite numbers (x y z, optionally w or r g "
+                                         "b) after 'v', got '2x'");
+  EXPECT_EQ(errorFor(tri + "vn 0 nan 1\n"), "cloth.obj: at line 4: expected 3 finite numbers after 'vn', got 'nan'");
+  EXPECT_EQ(errorFor(tri + "f 1 2 x\n"), "cloth.obj: at line 4: expected face vertices of non-zero integer indices "
+                                          "(i, i/j, i//k or i/j/k) after 'f', got 'x'");
+  EXPECT_EQ(errorFor(tri + "f 1 2 0\n"), "cloth.obj: at line 4: expected face vertices of non-zero integer indices "
+                                          "(i, i/j, i//k or i/j/k) after 'f', got '0'");
+  EXPECT_EQ(errorFor(tri + "f 1 2 99999999999\n"), "cloth.obj: at line 4: expected face vertices of non-zero "
+                                                    "integer indices (i, i/j, i//k or i/j/k) after 'f', got "
+                                                    "'99999999999'");
+  EXPECT_EQ(errorFor(tri + "f 1 2\n"), "cloth.obj: at line 4: expected at least 3 vertices after 'f', got 2");
+  // a control character in a bad token is not echoed into the message
+  EXPECT_EQ(errorFor("v 1 2 \x1b[2J\n"), "cloth.obj: at line 1: expected 3 finite numbers (x y z, optionally w or r g "
+                                          "b) after 'v', got '?[2J'");
+  // well-formed: comments, CRLF, tabs, '+', colours, negative and slashed indices
+  const TriangleMesh m = parseObjMesh("# c\r\nv +1\t0 0 # end\r\nv 1 1 0 0.5 0.5 0.5\r\nv 0 1 0\r\nvt 0 0\r\n"
+                                      "vn 0 0 1\r\nf -3/1/1 2//1 3/1\r\n",
+                                      "ok.obj");
+  ASSERT_EQ(m.vertices.size(), 3u);
+  EXPECT_TRUE(m.vertices[0].isApprox(Vec3(1, 0, 0)));
+  ASSERT_EQ(m.triangles.size(), 1u);
+}
+
+TEST(MeshObj, OversizedFileIsRefusedBeforeReading) {
+  // a sparse file: its size is known without writing a gigabyte
+  TempFile f("soak_mesh_huge", "v 0 0 0\n");
+  std::filesystem::resize_file(f.path, kMaxObjBytes + 1);
+  EXPECT_EQ(errorOf([&] { loadObjMesh(f.path.string()); }),
+            f.path.string() + ": expected an OBJ file of at most 1024 MiB, got 1073741825 bytes");
 }
 
 }  // namespace
