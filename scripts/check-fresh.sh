@@ -103,6 +103,7 @@ echo "check-fresh: a clean clone of $(git -C "$repo" rev-parse --short HEAD) is 
 # runs one README command in the root, with an environment like a fresh login's
 run_in_root() {
   chroot "$root" /usr/bin/env -i HOME=/root LANG=C.UTF-8 TERM=dumb CI="${CI:-}" \
+    SOAK_SKIP_PORTABLE="${SOAK_SKIP_PORTABLE:-0}" \
     PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
     bash -c "cd /work/soak && $1"
 }
