@@ -228,7 +228,7 @@ inline float stickingCoefficient(float si, float sj, float st, float strength, f
   const float fc = strength - rate * std::fabs((si - st) * (sj - st));
   const float rampI = si / st < 1.0f ? si / st : 1.0f, rampJ = sj / st < 1.0f ? sj / st : 1.0f;
   const float coef = fc * (st > 0.0f ? rampI * rampJ : 1.0f);
-  return (si > 0.0f) & (sj > 0.0f) & (fc > 0.0f) & (coef > 0.0f) ? coef : 0.0f;
+  return ((si > 0.0f) & (sj > 0.0f) & (fc > 0.0f) & (coef > 0.0f)) ? coef : 0.0f;
 }
 inline float stickingCoefficient(const WettingParams& w, float si, float sj) {
   return stickingCoefficient(si, sj, w.saturationSticky, w.stickingStrength, w.stickingRate);
