@@ -36,7 +36,9 @@ struct WaterParams {
 };
 
 struct ClothMaterial {
-  float particleMass = 0.0066f;     // kg per cloth particle when dry (Table 1)
+  float particleMass = 0.0066f;     // kg per cloth particle when dry (Table 1), unless arealDensity > 0
+  float arealDensity = 0.0f;        // kg/m^2 of dry fabric when > 0: a particle weighs it times its mixed
+                                    // Voronoi area on the rest mesh, so a remesh keeps the weight
   float restDensity = 800.0f;       // kg/m^3 (Table 1)
   float stretchCompliance = 0.0f;   // m/N, XPBD compliance of Eq. 8 (0 = inextensible)
   float bendCompliance = 1.0e-3f;   // 1/(N m), XPBD compliance of Eq. 9

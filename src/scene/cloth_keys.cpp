@@ -31,7 +31,11 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
                     "expected false on a piece with \"solver\": \"implicit\" (the implicit solver has no "
                     "self-collision), got true");
   }
+  if (r.has("particleMass") && r.has("arealDensity"))
+    r.log().error(r.pathOf("arealDensity"), "expected either particleMass (kg a particle) or arealDensity (kg/m^2), "
+                                            "got both");
   m.particleMass = r.number("particleMass", d.particleMass, Range::positive());
+  m.arealDensity = r.has("arealDensity") ? r.number("arealDensity", d.arealDensity, Range::positive()) : 0.0f;
   m.restDensity = r.number("restDensity", d.restDensity, Range::positive());
   m.stretchCompliance = r.number("stretchCompliance", d.stretchCompliance, Range::nonNegative());
   m.bendCompliance = r.number("bendCompliance", d.bendCompliance, Range::nonNegative());

@@ -2,7 +2,11 @@
 // constraints of the whole cloth rebuilt (cloth_piece.hpp)
 #include "scene/cloth_piece.hpp"
 
+#include <soak/error.hpp>
+
 #include <algorithm>
+#include <array>
+#include <string>
 
 #include "pbd/cloth.hpp"
 
@@ -38,6 +42,49 @@ void buildClothAdjacency(Model& model) {
   }
 }
 
+// adds a triangle's area to its vertices as the mixed Voronoi areas of Meyer et al. 2003: each
+// vertex's Voronoi region when no angle is obtuse, else half the area to the obtuse vertex and a
+// quarter to the others; the three shares add up to the area, and on a regular grid every inner
+// vertex gets one cell whichever way the cells are split
+void addMixedAreas(const TriangleMesh& mesh, const std::array<int, 3>& t, std::vector<double>& area) {
+  const Vec3d p[3] = {mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
+                      mesh.vertices[t[2]].cast<double>()};
+  const double whole = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+  for (int k = 0; k < 3; ++k) {
+    const Vec3d a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+    if (a.dot(b) < 0.0) {  // obtuse at vertex k
+      for (int j = 0; j < 3; ++j) area[t[j]] += whole * (j == k ? 0.5 : 0.25);
+      return;
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    // the edges from vertex k, each weighted by the cotangent of the angle facing it
+    const Vec3d& o = p[k];
+    const Vec3d& q = p[(k + 1) % 3];
+    const Vec3d& r = p[(k + 2) % 3];
+    const auto cot = [](const Vec3d& u, const Vec3d& v) { return u.dot(v) / u.cross(v).norm(); };
+    area[t[k]] += ((r - o).squaredNorm() * cot(o - q, r - q) + (q - o).squaredNorm() * cot(o - r, q - r)) / 8.0;
+  }
+}
+
+// the dry mass of each vertex: material.particleMass, or with an areal density the vertex's mixed
+// Voronoi area of the rest mesh times that density (a vertex in no triangle is refused)
+std::vector<float> dryMasses(const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
+                             const std::string& source) {
+  if (material.arealDensity <= 0.0f) return std::vector<float>(mesh.vertices.size(), material.particleMass);
+  std::vector<double> area(mesh.vertices.size(), 0.0);
+  for (const auto& t : mesh.triangles) addMixedAreas(mesh, t, area);
+  std::vector<float> mass(mesh.vertices.size());
+  for (size_t v = 0; v < mass.size(); ++v) {
+    if (!(area[v] > 0.0))
+      throw Error(source + ": cloth '" + name + "': vertex " + std::to_string(v) +
+                  " (0-based) belongs to no triangle of non-zero area; expected every vertex in one when the "
+                  "material gives an arealDensity (its mass would be 0)");
+    mass[v] = static_cast<float>(material.arealDensity * area[v]);
+  }
+  return mass;
+}
+
 }  // namespace
 
 // Cloth pieces are added before any water particle exists. The scene loader then creates one particle
@@ -45,6 +92,7 @@ void buildClothAdjacency(Model& model) {
 void addClothPiece(Model& model, const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
                    const std::vector<int>& pinnedVertices, const std::string& source, ClothSolver solver) {
   validateClothMesh(name, mesh, pinnedVertices, source);  // first: a refused piece leaves the model untouched
+  const std::vector<float> mass = dryMasses(name, mesh, material, source);
 
   ClothPiece piece;
   piece.name = name;
@@ -59,7 +107,7 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
     model.triangles.push_back(
         {tri[0] + piece.firstParticle, tri[1] + piece.firstParticle, tri[2] + piece.firstParticle});
   model.clothRestPosition.insert(model.clothRestPosition.end(), mesh.vertices.begin(), mesh.vertices.end());
-  model.clothDryMass.insert(model.clothDryMass.end(), mesh.vertices.size(), material.particleMass);
+  model.clothDryMass.insert(model.clothDryMass.end(), mass.begin(), mass.end());
   model.clothPinned.insert(model.clothPinned.end(), mesh.vertices.size(), uint8_t{0});
   for (int v : pinnedVertices) model.clothPinned[piece.firstParticle + v] = 1;
   model.clothImplicit.insert(model.clothImplicit.end(), mesh.vertices.size(),

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "scene/cloth_piece.hpp"
 #include "scene/scene_support.hpp"
 
 namespace soak {
@@ -126,6 +127,60 @@ TEST(ClothKeys, MaterialKeysReachThePieceAndPbdKeysAreRefusedOnAnImplicitOne) {
   const Scene t = fromString(kSmall, {"cloth.0.material.friction=0.6", "cloth.0.material.staticFriction=0.8"});
   EXPECT_FLOAT_EQ(t.model.pieces[0].material.friction, 0.6f);
   EXPECT_FLOAT_EQ(t.model.pieces[0].material.staticFriction, 0.8f);
+}
+
+}  // namespace
+}  // namespace soak
+
+namespace soak {
+namespace {
+
+using namespace soak::testing;
+
+// material.arealDensity: a vertex weighs the density times its mixed Voronoi area on the rest mesh,
+// so interior, edge and corner vertices of a grid weigh 1, 1/2 and 1/4 of a cell (whichever way the
+// rectangle splits its cells), and the sheet weighs density x area at any resolution
+TEST(ClothKeys, ArealDensityGivesTheSameWeightAtAnyResolution) {
+  const double density = 0.2, width = 0.5, depth = 0.4;
+  for (int n : {6, 21, 61}) {
+    const Scene s = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.5, 0.4], "resolution": [)" +
+                               std::to_string(n) + "," + std::to_string(n) +
+                               R"(]}, "material": {"arealDensity": 0.2}}]})");
+    double total = 0.0;
+    for (float m : s.model.clothDryMass) total += m;
+    EXPECT_NEAR(total, density * width * depth, 1e-5 * density * width * depth) << n << " x " << n;
+    const double cell = density * (width / (n - 1)) * (depth / (n - 1));
+    EXPECT_NEAR(s.model.clothDryMass[0], cell / 4, 1e-5 * cell);                            // a corner
+    EXPECT_NEAR(s.model.clothDryMass[1], cell / 2, 1e-5 * cell);                            // an edge
+    EXPECT_NEAR(s.model.clothDryMass[size_t(n + 1)], cell, 1e-5 * cell);                    // inside
+    EXPECT_FLOAT_EQ(s.state.particles.mass[size_t(n + 1)], s.model.clothDryMass[size_t(n + 1)]);
+  }
+  // without it, every particle weighs particleMass (Table 1)
+  const Scene table1 = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]}}]})");
+  for (float m : table1.model.clothDryMass) EXPECT_FLOAT_EQ(m, 0.0066f);
+}
+
+TEST(ClothKeys, ArealDensityAndParticleMassExcludeEachOtherAndEveryVertexNeedsATriangle) {
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]},
+      "material": {"arealDensity": 0.2, "particleMass": 0.001}}]})"),
+             "at cloth[0].material.arealDensity: expected either particleMass (kg a particle) or arealDensity");
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]},
+      "material": {"arealDensity": -1}}]})"),
+             "at cloth[0].material.arealDensity: expected a number > 0");
+  const TriangleMesh stray{{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(5, 5, 5)}, {{0, 1, 2}}};
+  ClothMaterial material;
+  material.arealDensity = 0.2f;
+  Model model;
+  try {
+    addClothPiece(model, "sheet", stray, material, {}, "scenes/stray.json");
+    ADD_FAILURE() << "a vertex in no triangle was given a mass";
+  } catch (const Error& e) {
+    EXPECT_HAS(std::string(e.what()), "scenes/stray.json: cloth 'sheet': vertex 3 (0-based) belongs to no triangle");
+  }
+  material.arealDensity = 0.0f;  // with particleMass such a vertex keeps its mass, as before
+  Model plain;
+  addClothPiece(plain, "sheet", stray, material, {}, "scenes/stray.json");
+  EXPECT_FLOAT_EQ(plain.clothDryMass[3], 0.0066f);
 }
 
 }  // namespace
