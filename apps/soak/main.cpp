@@ -21,14 +21,8 @@ std::string checkOverride(const std::string& s) {
   return {};
 }
 
-int realMain(int argc, char** argv) {
-  CLI::App app{"soak: cloth getting wet (position-based water and porous cloth)", "soak"};
-  app.set_version_flag("--version", std::string("soak ") + kVersion);
-  app.require_subcommand(1);
-  app.failure_message(CLI::FailureMessage::help);
-
-  RunOptions run;
-  for (int i = 0; i < argc; ++i) run.commandLine.emplace_back(argv[i]);
+// `soak run`'s arguments and options
+CLI::App* addRunCommand(CLI::App& app, RunOptions& run) {
   CLI::App* runCmd = app.add_subcommand("run", "simulate a scene and write its frames");
   runCmd->add_option("scene", run.scene, "scene file (JSON)")->required();
   runCmd->add_option("-o,--out", run.outDir, "output directory (created; must be empty unless --overwrite)")
@@ -46,17 +40,34 @@ int realMain(int argc, char** argv) {
       ->check(CLI::Range(1, 1000000));
   runCmd->add_flag("--overwrite", run.overwrite, "write into a non-empty output directory, replacing soak's files");
   runCmd->add_flag("-q,--quiet", run.quiet, "no progress and no summary");
+  return runCmd;
+}
 
-  ResumeOptions resume;
-  resume.commandLine = run.commandLine;
+// `soak resume`'s arguments and options
+CLI::App* addResumeCommand(CLI::App& app, ResumeOptions& resume) {
   CLI::App* resumeCmd = app.add_subcommand("resume", "continue a run from its checkpoint (DIR/checkpoint.soak)");
   resumeCmd->add_option("dir", resume.dir, "the run's output directory")->required();
   resumeCmd->add_option("--frames", resume.frames, "last frame to write (default: run.json's frames; larger extends the run)")
       ->check(CLI::Range(1, 100000000));
-  resumeCmd->add_option("--threads", resume.threads, "worker threads (default: all cores)")->check(CLI::Range(1, 4096));
+  resumeCmd->add_option("--threads", resume.threads, "worker threads (default: all cores)")->check(CLI::Range(1, soak::kMaxThreads));
   resumeCmd->add_option("--checkpoint-every", resume.checkpointEvery, "frames between checkpoints (default: the run's)")
       ->check(CLI::Range(0, 1000000));
   resumeCmd->add_flag("-q,--quiet", resume.quiet, "no progress and no summary");
+  return resumeCmd;
+}
+
+int realMain(int argc, char** argv) {
+  CLI::App app{"soak: cloth getting wet (position-based water and porous cloth)", "soak"};
+  app.set_version_flag("--version", std::string("soak ") + kVersion);
+  app.require_subcommand(1);
+  app.failure_message(CLI::FailureMessage::help);
+
+  RunOptions run;
+  for (int i = 0; i < argc; ++i) run.commandLine.emplace_back(argv[i]);
+  CLI::App* runCmd = addRunCommand(app, run);
+  ResumeOptions resume;
+  resume.commandLine = run.commandLine;
+  CLI::App* resumeCmd = addResumeCommand(app, resume);
 
   ValidateOptions val;
   CLI::App* valCmd = app.add_subcommand("validate", "load and check a scene, print a summary");

@@ -22,7 +22,7 @@ void pathLengths(const Model& model, int source, std::vector<float>& dist) {
   dist[source] = 0.0f;
   queue.push({0.0f, source});
   while (!queue.empty()) {
-    // not a structured binding: clang 14 (the fuzz build) cannot capture one in the lambda below
+    // not a structured binding: the lambda below captures it, which C++17 forbids and not every C++20 compiler allows
     const float d = queue.top().first;
     const int i = queue.top().second;
     queue.pop();
