@@ -136,10 +136,17 @@ int validateCommand(const ValidateOptions& o) {
               blockParticleCount(m));
   std::printf("  cloth:       %zu pieces, %zu triangles, %zu pinned particles\n", m.pieces.size(), m.triangles.size(),
               pinned);
-  for (const ClothPiece& p : m.pieces)
+  for (const ClothPiece& p : m.pieces) {
+    double mass = 0.0, area = 0.0;  // dry, on the rest mesh
+    for (int i = p.firstParticle; i < p.firstParticle + p.particleCount; ++i) {
+      mass += m.clothDryMass[size_t(i)];
+      area += m.clothRestArea[size_t(i)];
+    }
     std::printf("    %-12s %d particles, %d triangles, %s solver%s\n", p.name.c_str(), p.particleCount, p.triangleCount,
                 p.solver == ClothSolver::Implicit ? "implicit (Chen 2012)" : "PBD",
                 p.garment.saturationMass ? ", saturation mass (Eq. 15-19)" : "");
+    std::printf("    %-12s %.4g m^2, %.4g kg dry (%.4g kg/m^2)\n", "", area, mass, area > 0.0 ? mass / area : 0.0);
+  }
   std::printf("  colliders:   %zu\n", m.colliders.size());
   for (const Collider& c : m.colliders) std::printf("    %s\n", c.name.c_str());
   std::printf("  emitters:    %zu\n", m.emitters.size());

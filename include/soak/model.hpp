@@ -143,6 +143,7 @@ struct Model {
   std::vector<std::array<int, 3>> triangles;     // cloth triangles, particle indices
   std::vector<Vec3> clothRestPosition;           // m, per cloth particle (initial shape)
   std::vector<float> clothDryMass;               // kg, per cloth particle
+  std::vector<float> clothRestArea;              // m^2, per cloth particle: its mixed Voronoi area on the rest mesh
   std::vector<uint8_t> clothPinned;              // 1 = kinematic: stays put (rest position, unless a caller moves it)
   std::vector<uint8_t> clothImplicit;            // 1 = in a piece solved implicitly (moved by src/garment)
   std::vector<int> vertexTriangleStart;          // CSR: triangles around a cloth particle

@@ -36,9 +36,10 @@ struct WaterParams {
 };
 
 struct ClothMaterial {
-  float particleMass = 0.0066f;     // kg per cloth particle when dry (Table 1), unless arealDensity > 0
-  float arealDensity = 0.0f;        // kg/m^2 of dry fabric when > 0: a particle weighs it times its mixed
-                                    // Voronoi area on the rest mesh, so a remesh keeps the weight
+  float particleMass = 0.0f;        // kg per cloth particle when dry and > 0 (Table 1: 0.0066); else arealDensity
+  float arealDensity = 16.5f;       // kg/m^2 of dry fabric: a particle weighs it times its mixed Voronoi area
+                                    // on the rest mesh, so a remesh keeps the weight (Table 1's 0.0066 kg on
+                                    // its 0.02 m spacing)
   float restDensity = 800.0f;       // kg/m^3 (Table 1)
   float stretchCompliance = 0.0f;   // m/N, XPBD compliance of Eq. 8 (0 = inextensible)
   float bendCompliance = 1.0e-3f;   // 1/(N m), XPBD compliance of Eq. 9
@@ -61,6 +62,8 @@ struct WettingParams {
   float saturationMax = 0.4f;        // S^MAX: absorption stops here (Eq. 11)
   float initialSaturation = 0.0f;    // S of every cloth particle at load (Fig. 6 starts saturated)
   float rateStep = 0.015f;           // s, the step the rates kappa^a and the Eq. 18 transfer refer to
+  float referenceArea = 4.0e-4f;     // m^2, the cloth area m^threshold, eta^e, eta^ad and kappa^ad are given for
+                                     // (Table 1's 0.02 m spacing squared); 0: per particle, as printed
   bool everySubstep = false;         // false: the wetting stages run once a step, with the step's dt (Algorithm 1)
   // absorption, Eq. 11
   bool absorption = true;
@@ -77,14 +80,14 @@ struct WettingParams {
   // emission, Eq. 18-19
   bool emission = true;
   float beta = 1.5f;                 // s^2/m, beta of Eq. 18
-  float massThreshold = 0.002f;      // kg, m^threshold: a buffer this full forms a drip
+  float massThreshold = 0.002f;      // kg, m^threshold for a particle of referenceArea: a buffer this full forms a drip
   float maxDripMass = 0.0f;          // kg, a hanging drip this heavy is let go (0: four water.particleMass)
   float attraction = 10.0f;          // m/s^2, kappa^e of Eq. 19
-  float attractionSaturation = 0.01f;  // kg, eta^e of Eq. 19
+  float attractionSaturation = 0.01f;  // kg, eta^e of Eq. 19 (for a particle of referenceArea)
   // wet dynamics, Eq. 20 and Eq. 22
   bool sticking = true;
-  float stickingRate = 0.3f;         // N, kappa^ad of Eq. 20
-  float stickingStrength = 0.02f;    // N, eta^ad of Eq. 20
+  float stickingRate = 0.3f;         // N, kappa^ad of Eq. 20 (for a pair of referenceArea particles)
+  float stickingStrength = 0.02f;    // N, eta^ad of Eq. 20 (likewise)
   bool permeability = true;          // Eq. 22: wetter triangles let water through
 };
 

@@ -34,8 +34,9 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   if (r.has("particleMass") && r.has("arealDensity"))
     r.log().error(r.pathOf("arealDensity"), "expected either particleMass (kg a particle) or arealDensity (kg/m^2), "
                                             "got both");
-  m.particleMass = r.number("particleMass", d.particleMass, Range::positive());
-  m.arealDensity = r.has("arealDensity") ? r.number("arealDensity", d.arealDensity, Range::positive()) : 0.0f;
+  // one of the two sets the dry mass: particleMass when given, else arealDensity (default)
+  m.particleMass = r.has("particleMass") ? r.number("particleMass", std::nullopt, Range::positive()) : 0.0f;
+  m.arealDensity = r.has("particleMass") ? 0.0f : r.number("arealDensity", d.arealDensity, Range::positive());
   m.restDensity = r.number("restDensity", d.restDensity, Range::positive());
   m.stretchCompliance = r.number("stretchCompliance", d.stretchCompliance, Range::nonNegative());
   m.bendCompliance = r.number("bendCompliance", d.bendCompliance, Range::nonNegative());

@@ -67,20 +67,25 @@ void addMixedAreas(const TriangleMesh& mesh, const std::array<int, 3>& t, std::v
   }
 }
 
-// the dry mass of each vertex: material.particleMass, or with an areal density the vertex's mixed
-// Voronoi area of the rest mesh times that density (a vertex in no triangle is refused)
-std::vector<float> dryMasses(const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
-                             const std::string& source) {
-  if (material.arealDensity <= 0.0f) return std::vector<float>(mesh.vertices.size(), material.particleMass);
+// each vertex's mixed Voronoi area on the rest mesh, m^2 (0 for a vertex in no triangle)
+std::vector<float> restAreas(const TriangleMesh& mesh) {
   std::vector<double> area(mesh.vertices.size(), 0.0);
   for (const auto& t : mesh.triangles) addMixedAreas(mesh, t, area);
-  std::vector<float> mass(mesh.vertices.size());
+  return std::vector<float>(area.begin(), area.end());
+}
+
+// the dry mass of each vertex: material.particleMass when it is set, else the vertex's mixed Voronoi
+// area times material.arealDensity (a vertex in no triangle is refused: its mass would be 0)
+std::vector<float> dryMasses(const std::string& name, const std::vector<float>& area, const ClothMaterial& material,
+                             const std::string& source) {
+  if (material.particleMass > 0.0f) return std::vector<float>(area.size(), material.particleMass);
+  std::vector<float> mass(area.size());
   for (size_t v = 0; v < mass.size(); ++v) {
-    if (!(area[v] > 0.0))
+    if (!(area[v] > 0.0f))
       throw Error(source + ": cloth '" + name + "': vertex " + std::to_string(v) +
                   " (0-based) belongs to no triangle of non-zero area; expected every vertex in one when the "
-                  "material gives an arealDensity (its mass would be 0)");
-    mass[v] = static_cast<float>(material.arealDensity * area[v]);
+                  "mass comes from material.arealDensity (its mass would be 0; give particleMass instead)");
+    mass[v] = static_cast<float>(static_cast<double>(material.arealDensity) * area[v]);
   }
   return mass;
 }
@@ -92,7 +97,8 @@ std::vector<float> dryMasses(const std::string& name, const TriangleMesh& mesh, 
 void addClothPiece(Model& model, const std::string& name, const TriangleMesh& mesh, const ClothMaterial& material,
                    const std::vector<int>& pinnedVertices, const std::string& source, ClothSolver solver) {
   validateClothMesh(name, mesh, pinnedVertices, source);  // first: a refused piece leaves the model untouched
-  const std::vector<float> mass = dryMasses(name, mesh, material, source);
+  const std::vector<float> area = restAreas(mesh);
+  const std::vector<float> mass = dryMasses(name, area, material, source);
 
   ClothPiece piece;
   piece.name = name;
@@ -108,6 +114,7 @@ void addClothPiece(Model& model, const std::string& name, const TriangleMesh& me
         {tri[0] + piece.firstParticle, tri[1] + piece.firstParticle, tri[2] + piece.firstParticle});
   model.clothRestPosition.insert(model.clothRestPosition.end(), mesh.vertices.begin(), mesh.vertices.end());
   model.clothDryMass.insert(model.clothDryMass.end(), mass.begin(), mass.end());
+  model.clothRestArea.insert(model.clothRestArea.end(), area.begin(), area.end());
   model.clothPinned.insert(model.clothPinned.end(), mesh.vertices.size(), uint8_t{0});
   for (int v : pinnedVertices) model.clothPinned[piece.firstParticle + v] = 1;
   model.clothImplicit.insert(model.clothImplicit.end(), mesh.vertices.size(),

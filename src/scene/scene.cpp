@@ -178,6 +178,7 @@ void readWetting(ObjectReader r, WettingParams& w) {
   w.c = r.number("c", d.c, Range::positive());
   w.rateStep = r.number("rateStep", d.rateStep, Range::positive());
   w.everySubstep = r.boolean("everySubstep", d.everySubstep);
+  w.referenceArea = r.number("referenceArea", d.referenceArea, Range::nonNegative());
   ObjectReader s = r.object("saturation");
   const Range fraction{0.0, 1.0, true, false};  // (0, 1]
   w.saturationSticky = s.number("sticky", d.saturationSticky, fraction);
@@ -231,22 +232,36 @@ void readWetting(ObjectReader r, WettingParams& w) {
 }
 
 // a drip needs m^threshold in one buffer: refuse a threshold above what a typical (median) particle of
-// some piece can hold at S^MAX (S^MAX V / c, Eq. 10)
+// some piece can hold at S^MAX (S^MAX V / c, Eq. 10), both per referenceArea of cloth; and, with a
+// referenceArea, a vertex in no triangle (no area: its m^threshold would be 0)
 void checkDripThreshold(ErrorLog& log, const Model& model, const std::vector<float>& volume) {
   const WettingParams& w = model.wetting;
   if (!w.enabled || !w.emission) return;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];
-    std::vector<float> v(volume.begin() + piece.firstParticle,
-                         volume.begin() + piece.firstParticle + piece.particleCount);
-    if (v.empty()) continue;
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-    const double hold = double(w.saturationMax) * v[v.size() / 2] / w.c;
-    if (double(w.massThreshold) > hold)
+    std::vector<double> hold;  // kg per referenceArea
+    for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
+      const float share = areaShare(w.referenceArea, model.clothRestArea[size_t(i)]);
+      if (share > 0.0f) {
+        hold.push_back(double(w.saturationMax) * volume[size_t(i)] / w.c / share);
+        continue;
+      }
+      log.error("wetting.referenceArea",
+                fmt::format("expected 0 (amounts per particle) when cloth[{}] ('{}') has a vertex in no triangle "
+                            "(vertex {}, 0-based: no area to share m^threshold by), got {}",
+                            k, piece.name, i - piece.firstParticle, w.referenceArea));
+      break;
+    }
+    if (hold.size() < size_t(piece.particleCount) || hold.empty()) continue;
+    std::nth_element(hold.begin(), hold.begin() + std::ptrdiff_t(hold.size() / 2), hold.end());
+    const double median = hold[hold.size() / 2];
+    if (double(w.massThreshold) > median)
       log.error("wetting.emission.massThreshold",
                 fmt::format("expected at most the water a cloth particle of cloth[{}] ('{}') can hold, S^MAX V / c = "
-                            "{:.4g} kg (median V = {:.4g} m^3), got {} (lower it, or lower wetting.c)",
-                            k, piece.name, hold, v[v.size() / 2], w.massThreshold));
+                            "{:.4g} kg (the median{}), got {} (lower it, or lower wetting.c)",
+                            k, piece.name, median,
+                            w.referenceArea > 0.0f ? fmt::format(" per wetting.referenceArea = {} m^2", w.referenceArea) : "",
+                            w.massThreshold));
   }
 }
 

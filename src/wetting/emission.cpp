@@ -113,14 +113,14 @@ void fillBuffers(const Model& model, State& state, const WettingScratch& s) {
   // EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as computeSaturation, in the same loop. A buffer
   // holding m^threshold (a drip that found no place, under water) takes no more, from its particle or
   // from above (moveBuffersDown), so a sheet under water does not pump the pool into its buffers
-  // (departure: docs/models.md)
+  // (departure: docs/models.md). m^threshold is per referenceArea of cloth: times the particle's areaShare
   const double full = static_cast<double>(w.massThreshold);
   std::vector<float>& sat = state.clothSaturation;
   sat.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
     const double keep = static_cast<double>(w.saturationEmit) * s.volume[i] / c;
     const double excess = state.clothWater[i] - keep;
-    if (excess > 0.0 && state.clothBuffer[i] < full) {  // a full buffer takes no more (below)
+    if (excess > 0.0 && state.clothBuffer[i] < full * s.areaShare[i]) {  // a full buffer takes no more (below)
       state.clothWater[i] = keep;
       state.clothBuffer[i] += excess;
     }
@@ -237,13 +237,14 @@ void outflowScales(const Model& model, const NeighborLists& nb, const FlowInputs
     const float vu = volumeAll[u];
     const double* const B = bufferAll;
     const double bu = bufferAll[u], rateL = rate, fullL = full;
+    const float* const A = s.areaShare.data();
 #pragma omp simd
     for (uint32_t k = 0; k < count; ++k) {
       const uint32_t l = J[k];
       const bool same = (l < clothL) & (P[l] == phu);
       const uint32_t ll = same ? l : static_cast<uint32_t>(u);  // buffers hold cloth only
       const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
-      const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL);  // and l's buffer takes water
+      const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL * A[ll]);  // and l's buffer takes water
       T[k] = bufferFlow(rateL, cosLU, vu, W[k], bu) * (below ? 1.0 : 0.0);  // +-0 where not below
     }
     double out = 0.0;
@@ -290,7 +291,8 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
     const uint32_t clothL = cloth;
     const int32_t phk = P[k];
     const float vk = VL[k], osk = OS[k];
-    const double bk = B[k], rateL = rate, fullL = full;
+    const double bk = B[k], rateL = rate, fullL = full, fullK = full * s.areaShare[k];
+    const float* const A = s.areaShare.data();
 #pragma omp simd
     for (uint32_t e = 0; e < count; ++e) {
       const uint32_t j = J[e];
@@ -298,8 +300,8 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
       const uint32_t jj = same ? j : static_cast<uint32_t>(k);
       const float cosKJ = C[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
       const float osj = OS[jj];
-      const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullL);     // j sheds into k
-      const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL);   // k sheds into j
+      const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullK);     // j sheds into k
+      const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL * A[jj]);   // k sheds into j
       // outScale_u bufferFlow(u -> l)
       const double in = static_cast<double>(osj) * bufferFlow(rateL, cosKJ, VL[jj], W[e], B[jj]);
       const double out = static_cast<double>(osk) * bufferFlow(rateL, -cosKJ, vk, W[e], bk);
@@ -332,8 +334,10 @@ void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, 
 }
 
 // 4a. the drips still hanging: kept in state.dripId / dripSource and in s.dripOf (the drip of each
-// source, -1: none), each fed from its source's buffer up to maxDrip
+// source, -1: none), each fed from its source's buffer up to maxDrip (at least the source's m^threshold)
 void feedHangingDrips(const Model& model, State& state, WettingScratch& s, float maxDrip) {
+  const float threshold = model.wetting.massThreshold;
+  const auto largest = [&](int64_t src) { return std::max(maxDrip, threshold * s.areaShare[src]); };
   const int64_t nc = model.numCloth;
   Particles& p = state.particles;
   const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
@@ -348,7 +352,7 @@ void feedHangingDrips(const Model& model, State& state, WettingScratch& s, float
   for (size_t d = 0; d < state.dripId.size(); ++d) {
     const int64_t q = dripIndex[d];
     const int32_t src = state.dripSource[d];
-    if (q < 0 || p.mass[q] <= 0.0f || p.mass[q] >= maxDrip || (p.x[q] - p.x[src]).norm() >= p.radius[q]) continue;
+    if (q < 0 || p.mass[q] <= 0.0f || p.mass[q] >= largest(src) || (p.x[q] - p.x[src]).norm() >= p.radius[q]) continue;
     state.dripId[kept] = state.dripId[d];
     state.dripSource[kept++] = src;
     dripOf[src] = q;
@@ -359,7 +363,7 @@ void feedHangingDrips(const Model& model, State& state, WettingScratch& s, float
     const int64_t q = dripOf[i];
     if (q < 0 || state.clothBuffer[i] <= 0.0) continue;
     const float before = p.mass[q];
-    const float after = std::min(before + static_cast<float>(state.clothBuffer[i]), maxDrip);
+    const float after = std::min(before + static_cast<float>(state.clothBuffer[i]), largest(i));
     if (!(after > before)) continue;
     state.clothBuffer[i] -= static_cast<double>(after) - static_cast<double>(before);  // exact: both floats
     p.setMass(static_cast<size_t>(q), after, false);
@@ -367,8 +371,9 @@ void feedHangingDrips(const Model& model, State& state, WettingScratch& s, float
   }
 }
 
-// 4b. a new drip below every source whose buffer holds m^threshold and that has none hanging, at the
-// first place with room (Eq. 18's emission; the places: DripDirections); returns how many
+// 4b. a new drip below every source whose buffer holds its m^threshold (times its areaShare) and that
+// has none hanging, at the first place with room (Eq. 18's emission; the places: DripDirections);
+// returns how many
 size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, const NeighborGrid& grid,
                      const std::vector<ColliderPose>& poses, WettingScratch& s) {
   const WettingParams& w = model.wetting;
@@ -378,8 +383,8 @@ size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, 
   const float m0 = model.water.particleMass, h0 = model.water.supportRadius, rho0 = model.water.restDensity;
   const std::vector<int64_t>& dripOf = s.dripOf;
   const size_t gridSize = grid.cellEntries.size();
-  const float mDrip = w.massThreshold;
-  const float hDrip = std::cbrt(mDrip / m0) * h0;  // h_p = (m_p / m0)^(1/3) h0
+  const auto dripMass = [&](int32_t i) { return w.massThreshold * s.areaShare[static_cast<size_t>(i)]; };
+  const auto dripRadius = [&](int32_t i) { return std::cbrt(dripMass(i) / m0) * h0; };  // h_p = (m_p / m0)^(1/3) h0
   // a place inside a collider (below a sheet lying on the floor or on a ball) would be pushed out at
   // the next substep, through the far side of a thin floor or flung off the ball (departure: docs/models.md)
   const float clearance = contactMargin(model, kWaterPhase);
@@ -389,7 +394,7 @@ size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, 
       if (colliderDistance(model.colliders[c], poses[c], y, nullptr) < clearance) return false;
     return true;
   };
-  const auto place = [&](const DripDirections& along, const Vec3& xi, int t, Vec3& y) {
+  const auto place = [&](const DripDirections& along, const Vec3& xi, float hDrip, int t, Vec3& y) {
     return along.placement(xi, hDrip, t, y) && clearOfColliders(y);
   };
   // the sources, in cloth order; then, in parallel, each one's first placement that the density
@@ -400,7 +405,8 @@ size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, 
   std::vector<int32_t>& sources = s.dripSources;
   sources.clear();
   for (int64_t i = 0; i < nc; ++i)
-    if (dripOf[i] < 0 && state.clothBuffer[i] >= static_cast<double>(mDrip)) sources.push_back(static_cast<int32_t>(i));
+    if (dripOf[i] < 0 && state.clothBuffer[i] >= static_cast<double>(dripMass(static_cast<int32_t>(i))))
+      sources.push_back(static_cast<int32_t>(i));
   const int64_t nSources = static_cast<int64_t>(sources.size());
   s.dripTry.assign(sources.size(), -1);
   s.dripBase.assign(sources.size(), 0.0f);
@@ -408,11 +414,12 @@ size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, 
 #pragma omp parallel for schedule(dynamic, 4) if (nSources > 8)
   for (int64_t c = 0; c < nSources; ++c) {
     const int32_t i = sources[static_cast<size_t>(c)];
+    const float mDrip = dripMass(i), hDrip = dripRadius(i);
     s.dripNormal[static_cast<size_t>(c)] = vertexNormal(model, p.x, i);
     const DripDirections along(g, s.dripNormal[static_cast<size_t>(c)]);
     for (int t = 0; t < kDripTries; ++t) {
       Vec3 y;
-      if (!place(along, p.x[i], t, y)) continue;
+      if (!place(along, p.x[i], hDrip, t, y)) continue;
       const float rho = dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip, rho0);
       if (rho <= rho0) {
         s.dripTry[static_cast<size_t>(c)] = t;
@@ -427,12 +434,13 @@ size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, 
     const int32_t i = sources[static_cast<size_t>(c)];
     int t = s.dripTry[static_cast<size_t>(c)];
     if (t < 0) continue;  // crowded: try again at the next wetting pass
+    const float mDrip = dripMass(i), hDrip = dripRadius(i);
     const DripDirections along(g, s.dripNormal[static_cast<size_t>(c)]);
     Vec3 y;
-    place(along, p.x[i], t, y);
+    place(along, p.x[i], hDrip, t, y);
     bool placed = addNewDrips(s.dripBase[static_cast<size_t>(c)], p, gridSize, y, hDrip) <= rho0;
     while (!placed && ++t < kDripTries)
-      if (place(along, p.x[i], t, y))
+      if (place(along, p.x[i], hDrip, t, y))
         placed = addNewDrips(dripDensityBefore(model, p, grid, nb.big, s, y, mDrip, hDrip, rho0), p, gridSize, y, hDrip) <= rho0;
     if (!placed) continue;
     const uint32_t id = state.nextId++;
@@ -458,8 +466,7 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
   const FlowInputs in = flowInputs(model, state, nb, s);
   markTransfers(model, nb, in, s);                                 // Eq. 18: gravity beats the pull above
   moveBuffersDown(model, state, nb, in, s, h);                     // the buffers flow down
-  const float maxDrip = std::max(w.maxDripMass > 0.0f ? w.maxDripMass : 4.0f * model.water.particleMass,
-                                 w.massThreshold);
+  const float maxDrip = w.maxDripMass > 0.0f ? w.maxDripMass : 4.0f * model.water.particleMass;
   feedHangingDrips(model, state, s, maxDrip);                      // hanging drips grow, or let go
   const size_t made = placeNewDrips(model, state, nb, grid, poses, s);  // new drips where there is room
   updateWetMasses(model, state);                                   // the buffers moved: m = dry + held + buffer
@@ -488,7 +495,7 @@ void applyDripAttraction(const Model& model, State& state, const NeighborLists& 
       const float r2 = r.squaredNorm();
       if (r2 >= hq * hq || r2 < 1e-18f) return;
       // (Psi_i / rho0) W = V_i W(x_ip, h_p)
-      const float mag = w.attraction * (p.mass[i] + w.attractionSaturation * state.clothSaturation[i]) *
+      const float mag = w.attraction * (p.mass[i] + w.attractionSaturation * s.areaShare[i] * state.clothSaturation[i]) *
                         s.volume[i] * poly6(r2, hq);
       const Vec3 f = (mag / std::sqrt(r2)) * r;
       total += f;

@@ -158,6 +158,8 @@ void updatePorosity(const Model& model, State& state, const NeighborLists& nb, W
   const double c = model.wetting.c;
   s.volume.resize(static_cast<size_t>(nc));
   state.clothSaturation.resize(static_cast<size_t>(nc));
+  s.areaShare.resize(static_cast<size_t>(nc));
+  for (int64_t i = 0; i < nc; ++i) s.areaShare[i] = areaShare(model.wetting.referenceArea, model.clothRestArea[i]);
   // in the loop of the pair geometry, once i's pairs are done: V_i = 1 / sum_k W_ik (Eq. 10) as
   // clothVolumes (the same terms in the same order), S_i as computeSaturation, and the wet mass
   pairGeometryThen(model, p, nb, s, [&](int64_t i) {

@@ -23,7 +23,7 @@ namespace {
 // adds +0). Pointers copied to locals: the compiler does not vectorise through captures
 
 // what the pair loops read: the particles' arrays (x, rest position, radius, phase, saturation), the
-// neighbour lists' indices and the law's S^T, kappa^ad and eta^ad
+// neighbour lists' indices, each particle's areaShare and the law's S^T, kappa^ad and eta^ad
 struct StickingInputs {
   const float* xAll;
   const float* restAll;
@@ -31,6 +31,7 @@ struct StickingInputs {
   const int32_t* phaseAll;
   const float* satAll;
   const uint32_t* indexAll;
+  const float* shareAll;
   float st, rate, strength;
 };
 
@@ -44,11 +45,12 @@ Vec3 stickingForce(const StickingInputs& in, const NeighborLists& nb, int64_t nc
   const float* const H = in.radiusAll;
   const int32_t* const P = in.phaseAll;
   const float* const S = in.satAll;
+  const float* const A = in.shareAll;
   float* const Tx = s.pairFloat.get(3 * static_cast<size_t>(count));
   float* const Ty = Tx + count;
   float* const Tz = Ty + count;
   const uint32_t cloth = static_cast<uint32_t>(nc), self = static_cast<uint32_t>(i);
-  const float si = S[i], hi = H[i], xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
+  const float si = S[i], ai = A[i], hi = H[i], xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2];
   const float rxi = R[3 * i], ryi = R[3 * i + 1], rzi = R[3 * i + 2];
   const int32_t phi = P[i];
   const float stL = in.st, rateL = in.rate, strengthL = in.strength;
@@ -85,7 +87,8 @@ Vec3 stickingForce(const StickingInputs& in, const NeighborLists& nb, int64_t nc
     const float d = h2 - r2;
     const float w6 = kern * d * d * d, w0 = kern * h2 * h2 * h2;
     const float rs = ok ? r2 : 1.0f;
-    const float sc = ok ? coef * w6 / w0 / std::sqrt(rs) : 0.0f;
+    // eta^ad and kappa^ad are per pair of referenceArea particles: times both areaShares
+    const float sc = ok ? coef * (ai * A[jj]) * w6 / w0 / std::sqrt(rs) : 0.0f;
     Tx[k] = sc * rx;
     Ty[k] = sc * ry;
     Tz[k] = sc * rz;
@@ -106,7 +109,7 @@ void applySticking(const Model& model, State& state, const NeighborLists& nb, We
   const std::vector<float>& sat = state.clothSaturation;
   s.force.resize(static_cast<size_t>(nc));
   const StickingInputs in{p.x[0].data(), model.clothRestPosition[0].data(), p.radius.data(), p.phase.data(),
-                          sat.data(), nb.index.data(), w.saturationSticky, w.stickingRate, w.stickingStrength};
+                          sat.data(), nb.index.data(), s.areaShare.data(), w.saturationSticky, w.stickingRate, w.stickingStrength};
   parallelForDynamic(nc, kWetChunk, [&](int64_t i) {
     s.force[i] = sat[i] > 0.0f ? stickingForce(in, nb, nc, s, i) : Vec3(Vec3::Zero());
   });

@@ -36,6 +36,7 @@ struct WettingScratch {
   ThreadBuffers<float> pairFloat;
   ThreadBuffers<double> pairDouble;
   std::vector<float> volume;       // m^3, V_i of each cloth particle (Eq. 10) this pass
+  std::vector<float> areaShare;    // A_i / wetting.referenceArea of each cloth particle (areaShare), this pass
   std::vector<float> capacity;     // kg a cloth particle can still absorb (Eq. 11)
   std::vector<float> clothScale;   // share of its requests a cloth particle grants (Eq. 11)
   std::vector<float> waterScale;   // share of its mass a water particle can give (Eq. 11)
@@ -218,6 +219,14 @@ void findDrips(const Model& model, const State& state, std::vector<int64_t>& ind
 // Eq. 19: the cloth around a drip pulls it (and is pulled back) until it is heavy enough to fall
 void applyDripAttraction(const Model& model, State& state, const NeighborLists& nb, const WettingScratch& s,
                          float h);
+
+// a cloth particle's share of the amounts the scene gives per wetting.referenceArea of cloth
+// (m^threshold and eta^e; per pair, both shares times eta^ad and kappa^ad): its rest area A_i over
+// referenceArea, so a finer mesh of the same cloth drips and sticks alike; 1 when referenceArea is 0
+// (per particle, as Table 1 prints them; departure: docs/models.md)
+inline float areaShare(float referenceArea, float restArea) {
+  return referenceArea > 0.0f ? restArea / referenceArea : 1.0f;
+}
 
 // sticking.cpp ------------------------------------------------------------------------------------
 

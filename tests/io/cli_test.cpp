@@ -149,6 +149,8 @@ TEST(CliValidate, SummaryCountsParticlesAndPieces) {
   EXPECT_NE(r.out.find("64 water from blocks"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("1 pieces"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("3 substeps"), std::string::npos) << r.out;
+  // the piece's area and dry weight: 0.2 x 0.2 m at the default 16.5 kg/m^2
+  EXPECT_NE(r.out.find("0.04 m^2, 0.66 kg dry (16.5 kg/m^2)"), std::string::npos) << r.out;
 }
 
 TEST(CliValidate, EmittersAreNamedByKind) {

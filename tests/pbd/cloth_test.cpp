@@ -238,6 +238,7 @@ TEST(ClothSolver, StretchComplianceIsHookesLawIndependentOfIterationsAndStep) {
   const float alpha = 0.2f;  // m/N
   ClothMaterial mat;
   mat.stretchCompliance = alpha;
+  mat.particleMass = 0.0066f;  // Table 1's: the tension below is this weight's
   const TriangleMesh mesh{{Vec3(-0.1f, 0, 0), Vec3(0.1f, 0, 0), Vec3(0, -0.05f, 0)}, {{0, 2, 1}}};
   float drop[3];
   int run = 0;

@@ -155,8 +155,12 @@ TEST(ClothKeys, ArealDensityGivesTheSameWeightAtAnyResolution) {
     EXPECT_NEAR(s.model.clothDryMass[size_t(n + 1)], cell, 1e-5 * cell);                    // inside
     EXPECT_FLOAT_EQ(s.state.particles.mass[size_t(n + 1)], s.model.clothDryMass[size_t(n + 1)]);
   }
-  // without it, every particle weighs particleMass (Table 1)
-  const Scene table1 = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]}}]})");
+  // without it the default, Table 1's 0.0066 kg particle on its 0.02 m spacing: 16.5 kg/m^2
+  const Scene byDefault = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [16, 16]}}]})");
+  EXPECT_FLOAT_EQ(byDefault.model.clothDryMass[17], 0.0066f);  // an inner vertex: a 0.02 m cell
+  // with particleMass, every particle weighs it, whatever its area
+  const Scene table1 = fromString(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]},
+      "material": {"particleMass": 0.0066}}]})");
   for (float m : table1.model.clothDryMass) EXPECT_FLOAT_EQ(m, 0.0066f);
 }
 
@@ -177,7 +181,7 @@ TEST(ClothKeys, ArealDensityAndParticleMassExcludeEachOtherAndEveryVertexNeedsAT
   } catch (const Error& e) {
     EXPECT_HAS(std::string(e.what()), "scenes/stray.json: cloth 'sheet': vertex 3 (0-based) belongs to no triangle");
   }
-  material.arealDensity = 0.0f;  // with particleMass such a vertex keeps its mass, as before
+  material.particleMass = 0.0066f;  // with particleMass such a vertex keeps its mass
   Model plain;
   addClothPiece(plain, "sheet", stray, material, {}, "scenes/stray.json");
   EXPECT_FLOAT_EQ(plain.clothDryMass[3], 0.0066f);

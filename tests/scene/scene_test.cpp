@@ -72,7 +72,10 @@ TEST(SceneDefaults, EqualTable1OfShao2017) {
   EXPECT_FLOAT_EQ(s.model.water.particleMass, 0.0082f);
   ASSERT_EQ(s.model.pieces.size(), 1u);
   EXPECT_FLOAT_EQ(s.model.pieces[0].material.restDensity, 800.0f);
-  EXPECT_FLOAT_EQ(s.model.pieces[0].material.particleMass, 0.0066f);
+  // the cloth's default: Table 1's 0.0066 kg particle on its 0.02 m spacing, as an areal density
+  EXPECT_FLOAT_EQ(s.model.pieces[0].material.arealDensity, 0.0066f / (0.02f * 0.02f));
+  EXPECT_FLOAT_EQ(s.model.pieces[0].material.particleMass, 0.0f);
+  EXPECT_FLOAT_EQ(s.model.wetting.referenceArea, 0.02f * 0.02f);
   EXPECT_FLOAT_EQ(s.model.solver.gravity.y(), -9.81f);
   EXPECT_EQ(s.name, "test");  // the stem of the source name
   EXPECT_EQ(s.output.frames, 100);
@@ -94,7 +97,9 @@ TEST(SceneBuild, ClothParticlesFollowTheContract) {
     const bool second = i >= 12;
     EXPECT_EQ(p.phase[i], second ? 2 : 1);
     EXPECT_EQ(p.id[i], uint32_t(i));
-    EXPECT_FLOAT_EQ(p.mass[i], second ? 0.01f : 0.0066f);
+    // the first piece weighs the default areal density: 16.5 kg/m^2 x 0.01 m^2 cells (inside, 1/2 at an
+    // edge, 1/4 at a corner); the second particleMass
+    EXPECT_FLOAT_EQ(p.mass[i], second ? 0.01f : 16.5f * s.model.clothRestArea[i]);
     EXPECT_FLOAT_EQ(p.radius[i], 0.04f);
     EXPECT_TRUE(p.x[i] == s.model.clothRestPosition[i] && p.xPred[i] == p.x[i]);
     EXPECT_TRUE(p.v[i].isZero());
@@ -102,6 +107,9 @@ TEST(SceneBuild, ClothParticlesFollowTheContract) {
     EXPECT_EQ(s.model.clothPinned[i], pinned ? 1 : 0);
     EXPECT_FLOAT_EQ(p.invMass[i], pinned ? 0.0f : 1.0f / p.mass[i]);
   }
+  EXPECT_FLOAT_EQ(s.model.clothRestArea[5], 0.01f);  // inside the 4 x 3 grid of 0.1 m cells
+  EXPECT_FLOAT_EQ(s.model.clothRestArea[1], 0.005f);
+  EXPECT_FLOAT_EQ(s.model.clothRestArea[0], 0.0025f);
 }
 
 TEST(SceneBuild, CollidersAndEmittersAreRead) {

@@ -51,9 +51,12 @@ TEST(WettingEmission, NoDripBelowTheThresholdOneDripAtIt) {
                           R"(], "wetting": {}})");
   StageRig rig;
   rig.refresh(s.state, s.model);
-  const float thr = s.model.wetting.massThreshold;
   const size_t bottom = 5;
   ASSERT_NEAR(s.state.particles.x[bottom].y(), 0.9f, 1e-6f);
+  // m^threshold is per wetting.referenceArea (Table 1's 0.02 m cell): this edge particle has half a cell
+  const float share = areaShare(s.model.wetting.referenceArea, s.model.clothRestArea[bottom]);
+  ASSERT_NEAR(share, 0.5f, 1e-5f);
+  const float thr = s.model.wetting.massThreshold * share;
   s.state.clothBuffer[bottom] = 0.99 * thr;
   const float h = s.model.solver.dt;
   EXPECT_EQ(emitExcessWater(s.model, s.state, rig.nb, rig.grid, {}, rig.s, h), 0u);
@@ -150,7 +153,7 @@ TEST(WettingEmission, DripsMadeInOnePassDoNotCrowdEachOther) {
   // placement is searched in parallel, then settled in cloth order)
   Scene s = sceneFromJson(R"({"cloth": [)" +
                           rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.2f, 21, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
-                          R"(], "wetting": {"c": 4e-4}})");  // a 0.01 m cloth holds the 2 g threshold (docs/models.md on c)
+                          R"(], "wetting": {"c": 4e-4, "referenceArea": 0}})");  // a 0.01 m cloth holds the 2 g threshold (docs/models.md on c)
   StageRig rig;
   rig.refresh(s.state, s.model);
   const float thr = s.model.wetting.massThreshold;
@@ -202,7 +205,7 @@ TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
   // held water above S^EW goes to the buffers, and the buffers move down (Eq. 18)
   Scene s = sceneFromJson(R"({"cloth": [)" +
                           rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
-                          R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
+                          R"(], "wetting": {"referenceArea": 0, "saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
   StageRig rig;
   rig.refresh(s.state, s.model);
   const double before = accountedWater(s);
@@ -221,7 +224,7 @@ TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
   // without gravity nothing moves down: every buffer keeps its own excess
   Scene flat = sceneFromJson(R"({"solver": {"gravity": [0, 0, 0]}, "cloth": [)" +
                              rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) +
-                             R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
+                             R"(], "wetting": {"referenceArea": 0, "saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})");
   rig.refresh(flat.state, flat.model);
   emitExcessWater(flat.model, flat.state, rig.nb, rig.grid, {}, rig.s, flat.model.solver.dt);
   const size_t mid = 10 * 11 + 5;
@@ -233,7 +236,7 @@ TEST(WettingEmission, ExcessRunsDownAVerticalSheet) {
 // sheet under water does not pump the pool into its buffers (Fig. 5's buffers grew by 0.4 kg every
 // 0.3 s, Fig. 9(b)'s reached 3 kg on one particle)
 TEST(WettingEmission, AFullBufferTakesNoMore) {
-  const char* kWet = R"(], "wetting": {"saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})";
+  const char* kWet = R"(], "wetting": {"referenceArea": 0, "saturation": {"initial": 0.4}, "emission": {"massThreshold": 0.005}}})";
   for (bool fullBuffer : {false, true}) {
     Scene s = sceneFromJson(R"({"cloth": [)" +
                             rectangleJson("s", Vec3(0, 1, 0), 0.2f, 0.4f, 11, 21, "[1, 0, 0]", "[0, 1, 0]", kPinAll) + kWet);
