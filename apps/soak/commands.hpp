@@ -61,7 +61,21 @@ struct BenchOptions {
   bool quiet = false;
 };
 
+// `soak sweep` (apps/soak/sweep.cpp, docs/sweeps.md)
+struct SweepOptions {
+  std::string sweep;    // SWEEP.json
+  std::string outDir;   // the sweep's folder: DIR/vNNN per variant, DIR/summary.{csv,json}
+  int jobs = 1;         // variants at a time
+  int threads = 0;      // threads for the whole sweep, shared out (0: all cores)
+  int frames = -1;      // -1: the sweep's "frames", else the scene's
+  int only = -1;        // run only this variant (a Slurm array task); -1: every one
+  bool collect = false; // run nothing: measure the folders and write the summary
+  bool dryRun = false;  // list the variants and stop
+  bool quiet = false;
+};
+
 int runCommand(const RunOptions& o);
+int sweepCommand(const SweepOptions& o);
 int resumeCommand(const ResumeOptions& o);
 int validateCommand(const ValidateOptions& o);
 int benchCommand(const BenchOptions& o);

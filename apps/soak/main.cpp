@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include <soak/error.hpp>
+#include <soak/sweep.hpp>
 #include <soak/threads.hpp>
 
 #include <CLI/CLI.hpp>
@@ -56,6 +57,25 @@ CLI::App* addResumeCommand(CLI::App& app, ResumeOptions& resume) {
   return resumeCmd;
 }
 
+// `soak sweep`'s arguments and options
+CLI::App* addSweepCommand(CLI::App& app, SweepOptions& sweep) {
+  CLI::App* cmd = app.add_subcommand("sweep", "run every variant of a SWEEP.json (a wedge of scene values)");
+  cmd->add_option("sweep", sweep.sweep, "sweep file (JSON: scene, set, frames, axes or variants)")->required();
+  cmd->add_option("-o,--out", sweep.outDir, "the sweep's folder (DIR/vNNN per variant; reused to resume)")->required();
+  cmd->add_option("-j,--jobs", sweep.jobs, "variants at a time (default 1)")->check(CLI::Range(1, soak::kMaxThreads));
+  cmd->add_option("--threads", sweep.threads, "threads for the whole sweep, shared out among the jobs (default: all cores)")
+      ->check(CLI::Range(1, soak::kMaxThreads));
+  cmd->add_option("--frames", sweep.frames, "frames per variant (default: the sweep's frames, else the scene's)")
+      ->check(CLI::Range(0, 100000000));
+  CLI::Option* only = cmd->add_option("--only", sweep.only, "run only variant I (0-based; a Slurm array task)")
+                          ->check(CLI::Range(0, soak::kMaxSweepVariants - 1));
+  cmd->add_flag("--collect", sweep.collect, "run nothing: measure the variants' folders and write the summary")
+      ->excludes(only);
+  cmd->add_flag("--dry-run", sweep.dryRun, "check the variants, list them and stop");
+  cmd->add_flag("-q,--quiet", sweep.quiet, "no progress lines");
+  return cmd;
+}
+
 int realMain(int argc, char** argv) {
   CLI::App app{"soak: cloth getting wet (position-based water and porous cloth)", "soak"};
   app.set_version_flag("--version", std::string("soak ") + kVersion);
@@ -106,6 +126,9 @@ int realMain(int argc, char** argv) {
                      "grid and lists, the cloth solve and self-collision, the coupling search and passes, XSPH");
   benchCmd->add_flag("-q,--quiet", bench.quiet, "print no table (with --json)");
 
+  SweepOptions sweep;
+  CLI::App* sweepCmd = addSweepCommand(app, sweep);
+
   RenderCliOptions render;
   CLI::App* renderCmd = addRenderCommand(app, render);
   SurfaceCliOptions surface;
@@ -122,6 +145,7 @@ int realMain(int argc, char** argv) {
   if (*valCmd) return validateCommand(val);
   if (*renderCmd) return renderCommand(render);
   if (*surfaceCmd) return surfaceCommand(surface);
+  if (*sweepCmd) return sweepCommand(sweep);
   return benchCommand(bench);
 }
 

@@ -1,0 +1,185 @@
+// soak sweep end to end: the variants of a grid run into their folders with their values, N at a
+// time; the summary tables; a second run skips what is complete; a failing variant is marked and does
+// not stop the others; --only, --collect, --dry-run; bad sweep files refused before anything runs
+#include "io/cli_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <fcntl.h>
+#include <string>
+#include <thread>
+
+using namespace soak;
+using namespace soak::testing;
+
+namespace {
+
+#define EXPECT_HAS(haystack, needle) EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+// the tiny scene, and a sweep of it: 2 x 2 variants of 2 frames
+struct SweepFixture {
+  Cli cli;
+  std::string scene, sweep, out;
+  SweepFixture(const std::string& name, const std::string& body, int frames = 2)
+      : cli(name), scene(cli.writeScene("tiny.json", kTinyScene)),
+        sweep(cli.writeScene("sweep.json", R"({"scene": "tiny.json", "frames": )" + std::to_string(frames) + ", " + body + "}")),
+        out((cli.dir() / "out").string()) {}
+  Result run(const std::string& options = "") const { return cli.run("sweep '" + sweep + "' -o '" + out + "' " + options); }
+  nlohmann::json summary() const { return nlohmann::json::parse(readTextFile(out + "/summary.json")); }
+  nlohmann::json runJson(const std::string& v) const { return nlohmann::json::parse(readTextFile(out + "/" + v + "/run.json")); }
+};
+
+const char* kGrid = R"("axes": {"solver.substeps": [1, 2], "cloth.0.material.arealDensity": {"from": 10, "to": 20, "count": 2}})";
+
+}  // namespace
+
+TEST(CliSweep, AGridRunsEveryVariantWithItsValuesAndSummarises) {
+  const SweepFixture f("grid", kGrid);
+  const Result r = f.run("--jobs 2 --threads 2");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_HAS(r.out, "4 to run (0 complete), 2 at a time with 1 threads each");
+  const nlohmann::json s = f.summary();
+  ASSERT_EQ(s["variants"].size(), 4u);
+  // the first key slowest: v001 is substeps 1 with the second density
+  const nlohmann::json& v1 = s["variants"][1];
+  EXPECT_EQ(v1["variant"], "v001");
+  EXPECT_EQ(v1["params"]["solver.substeps"], 1);
+  EXPECT_DOUBLE_EQ(v1["params"]["cloth.0.material.arealDensity"].get<double>(), 20.0);
+  const nlohmann::json asRun = nlohmann::json::parse(readTextFile(f.out + "/v001/scene.json"));
+  EXPECT_DOUBLE_EQ(asRun["cloth"][0]["material"]["arealDensity"].get<double>(), 20.0);
+  EXPECT_EQ(asRun["solver"]["substeps"], 1);
+  for (const auto& v : s["variants"]) {
+    EXPECT_EQ(v["status"], "complete") << v.dump();
+    EXPECT_EQ(v["framesWritten"], 3);
+    EXPECT_GT(v["msPerStep"].get<double>(), 0.0);
+    // the cloth is pinned at its corners and sags under the block: stretched a little, not torn
+    EXPECT_GE(v["maxClothStrain"].get<double>(), 0.0);
+    EXPECT_LT(v["maxClothStrain"].get<double>(), 0.5);
+    EXPECT_TRUE(v["wetAreaFraction"].is_null());  // no wetting in the scene
+  }
+  EXPECT_EQ(f.runJson("v003")["threads"], 1);
+  const std::string csv = readTextFile(f.out + "/summary.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "variant,solver.substeps,cloth.0.material.arealDensity,status,error,framesWritten,frame,msPerStep,"
+            "heldWaterKg,wetAreaFraction,maxClothStrain");
+  EXPECT_HAS(csv, "\nv002,2,10.0,complete,,3,2,");
+
+  // a second run finds every variant complete and runs nothing
+  const std::string started = f.runJson("v000")["startTime"];
+  const Result again = f.run();
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_HAS(again.out, "0 to run (4 complete)");
+  EXPECT_EQ(f.runJson("v000")["startTime"], started);
+  // more frames: every variant runs again (here from scratch: the sweep gives no checkpoint to extend)
+  const Result more = f.run("--frames 3");
+  ASSERT_EQ(more.code, 0) << more.err;
+  EXPECT_HAS(more.out, "4 to run (0 complete)");
+  EXPECT_EQ(f.runJson("v000")["framesWritten"], 4);
+}
+
+TEST(CliSweep, AFailingVariantIsMarkedAndTheOthersRun) {
+  // the second variant's speed limit stops it at its first step (diverged); the third's scene is fine
+  const SweepFixture f("fail", R"("variants": [{"solver.maxSpeed": 50}, {"solver.maxSpeed": 1e-4}, {"solver.maxSpeed": 20}])");
+  const Result r = f.run("--jobs 1");
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_HAS(r.out, "2 complete, 1 failed");
+  const nlohmann::json s = f.summary();
+  EXPECT_EQ(s["variants"][0]["status"], "complete");
+  EXPECT_EQ(s["variants"][1]["status"], "diverged");
+  EXPECT_HAS(s["variants"][1]["error"].get<std::string>(), "above solver.maxSpeed");
+  EXPECT_EQ(s["variants"][2]["status"], "complete");
+}
+
+TEST(CliSweep, OnlyCollectAndDryRun) {
+  const SweepFixture f("only", kGrid);
+  const Result dry = f.run("--dry-run");
+  ASSERT_EQ(dry.code, 0) << dry.err;
+  EXPECT_HAS(dry.out, "v002  solver.substeps=2, cloth.0.material.arealDensity=10.0");
+  EXPECT_FALSE(fs::exists(f.out + "/sweep.json"));
+  // one array task's worth, then the summary without running anything
+  const Result one = f.run("--only 2 -q");
+  ASSERT_EQ(one.code, 0) << one.err;  // its own variant is complete (the others are still pending)
+  EXPECT_TRUE(fs::exists(f.out + "/v002/run.json"));
+  EXPECT_FALSE(fs::exists(f.out + "/v000"));
+  const Result collect = f.run("--collect");
+  EXPECT_EQ(collect.code, 1);  // not every variant is complete
+  EXPECT_HAS(collect.out, "1 complete, 0 failed, 0 interrupted, 3 pending");
+  EXPECT_EQ(f.summary()["variants"][0]["status"], "pending");
+  EXPECT_EQ(f.summary()["variants"][2]["status"], "complete");
+  const Result beyond = f.run("--only 4");
+  EXPECT_EQ(beyond.code, 1);
+  EXPECT_HAS(beyond.err, "--only 4: the sweep has variants 0 to 3");
+}
+
+TEST(CliSweep, BadSweepFilesAreRefusedBeforeAnythingRuns) {
+  const auto errorOf = [](const std::string& name, const std::string& body) {
+    const SweepFixture f(name, body);
+    const Result r = f.run();
+    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_FALSE(fs::exists(f.out)) << body;
+    return r.err;
+  };
+  EXPECT_HAS(errorOf("both", R"("axes": {"solver.substeps": [1]}, "variants": [{"solver.substeps": 1}])"),
+             "sweep.json: expected either \"axes\" (every combination) or \"variants\" (a list), not both or neither");
+  EXPECT_HAS(errorOf("count", R"("axes": {"solver.dt": {"from": 0.01, "to": 0.02, "count": 0}})"),
+             "sweep.json: at axes.solver.dt.count: expected an integer in [1, 10000]");
+  EXPECT_HAS(errorOf("keys", R"("variants": [{"solver.dt": 0.01}, {"solver.substeps": 2}])"),
+             "sweep.json: at variants[1]: expected the keys of variants[0] (solver.dt), in that order");
+  EXPECT_HAS(errorOf("unknown", R"("axis": {"solver.dt": [0.01]})"), "sweep.json: at axis: unknown key");
+  // a value the scene refuses names the variant, before any variant runs
+  EXPECT_HAS(errorOf("value", R"("axes": {"solver.substeps": [1, 0]})"),
+             "sweep.json: variant v001 (solver.substeps=0): ");
+  // a folder holding another sweep is not overwritten
+  const SweepFixture f("other", kGrid);
+  ASSERT_EQ(f.run("--only 0 -q").code, 0);
+  writeTextFile(f.sweep, R"({"scene": "tiny.json", "frames": 2, "axes": {"solver.substeps": [3]}})");
+  const Result r = f.run();
+  EXPECT_EQ(r.code, 1);
+  EXPECT_HAS(r.err, "holds another sweep");
+}
+
+// SIGTERM to the sweep: it passes the signal on once, each running variant writes its checkpoint and
+// stops, the summary says "interrupted"; the same command (here with fewer frames) resumes them
+TEST(CliSweep, SigtermInterruptsTheVariantsAndTheNextSweepResumesThem) {
+  const SweepFixture f("sigterm", R"("axes": {"solver.substeps": [1, 2]})", 100000);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open((f.cli.dir() / "log.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    ::execl(SOAK_BINARY, SOAK_BINARY, "sweep", f.sweep.c_str(), "-o", f.out.c_str(), "--jobs", "2", "--threads", "2",
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto written = [&](const std::string& v) {
+    try {
+      return f.runJson(v).value("framesWritten", 0);
+    } catch (const std::exception&) {
+      return 0;  // not written yet
+    }
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while ((written("v000") < 3 || written("v001") < 3) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(::kill(pid, SIGTERM), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << readTextFile((f.cli.dir() / "log.txt").string());
+  for (const auto& v : f.summary()["variants"]) {
+    EXPECT_EQ(v["status"], "interrupted") << v.dump();
+    EXPECT_HAS(v["error"].get<std::string>(), "SIGTERM");
+  }
+  const int last = std::max(written("v000"), written("v001")) + 1;
+  const Result r = f.run("--frames " + std::to_string(last));
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_HAS(r.out, "2 to run (0 complete)");
+  for (const char* v : {"v000", "v001"}) {
+    EXPECT_EQ(f.runJson(v)["status"], "ok");
+    EXPECT_EQ(f.runJson(v)["framesWritten"], last + 1);
+    EXPECT_EQ(f.runJson(v)["resumes"].size(), 1u) << f.runJson(v).dump();
+    EXPECT_HAS(readTextFile(f.out + "/" + v + ".log"), "--- soak sweep: resumed from the checkpoint ---");
+  }
+}
