@@ -70,8 +70,13 @@ struct SweepOptions {
   int frames = -1;      // -1: the sweep's "frames", else the scene's
   int only = -1;        // run only this variant (a Slurm array task); -1: every one
   bool collect = false; // run nothing: measure the folders and write the summary
-  bool dryRun = false;  // list the variants and stop
+  bool dryRun = false;  // list the variants and stop; with slurm: write the script, submit nothing
   bool quiet = false;
+  // --slurm: an sbatch job array, one task per variant to run, instead of running here
+  bool slurm = false;
+  std::string partition;  // empty: the cluster's default
+  std::string time;       // a task's time limit in sbatch's format; empty: the partition's
+  int cpusPerTask = 1;    // each task's CPUs (its soak run threads)
 };
 
 int runCommand(const RunOptions& o);

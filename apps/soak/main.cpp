@@ -1,5 +1,6 @@
 // soak command-line program: run, validate and bench scenes, render and mesh their output (docs/cli.md)
 #include "commands.hpp"
+#include "sweep_slurm.hpp"
 
 #include <soak/error.hpp>
 #include <soak/sweep.hpp>
@@ -71,8 +72,22 @@ CLI::App* addSweepCommand(CLI::App& app, SweepOptions& sweep) {
                           ->check(CLI::Range(0, soak::kMaxSweepVariants - 1));
   cmd->add_flag("--collect", sweep.collect, "run nothing: measure the variants' folders and write the summary")
       ->excludes(only);
-  cmd->add_flag("--dry-run", sweep.dryRun, "check the variants, list them and stop");
+  cmd->add_flag("--dry-run", sweep.dryRun, "check the variants, list them and stop (with --slurm: write the script only)");
   cmd->add_flag("-q,--quiet", sweep.quiet, "no progress lines");
+  CLI::Option* slurm = cmd->add_flag("--slurm", sweep.slurm,
+                                     "submit a Slurm job array (sbatch), one task per variant still to run, instead "
+                                     "of running here; DIR must be on a file system the nodes share")
+                           ->excludes(only);
+  const auto sbatchValue = [](const std::string& v) { return soak::cli::sbatchValueProblem(v); };
+  cmd->add_option("--partition", sweep.partition, "with --slurm: the partition (default: the cluster's)")
+      ->check(sbatchValue)
+      ->needs(slurm);
+  cmd->add_option("--time", sweep.time, "with --slurm: each task's time limit, as sbatch takes it (e.g. 2:00:00)")
+      ->check(sbatchValue)
+      ->needs(slurm);
+  cmd->add_option("--cpus-per-task", sweep.cpusPerTask, "with --slurm: each task's CPUs, its threads (default 1)")
+      ->check(CLI::Range(1, soak::kMaxThreads))
+      ->needs(slurm);
   return cmd;
 }
 

@@ -2,6 +2,7 @@
 // into DIR/vNNN; variants already complete are skipped, interrupted ones resumed from their
 // checkpoint; then the summary table (sweep_summary.cpp). docs/sweeps.md
 #include "commands.hpp"
+#include "sweep_slurm.hpp"
 #include "sweep_summary.hpp"
 
 #include <soak/error.hpp>
@@ -56,8 +57,9 @@ json sweepRecord(const SweepSpec& spec) {
 }
 
 // writes DIR/sweep.json, or checks that the one there is this sweep's (the frames may change: a
-// sweep is extended by asking for more)
-void claimFolder(const SweepSpec& spec, const std::string& dir) {
+// sweep is extended by asking for more) and, with `rewrite`, writes it again with the frames asked
+// for now (an array task only checks: its siblings read the same file)
+void claimFolder(const SweepSpec& spec, const std::string& dir, bool rewrite) {
   const std::string path = (fs::path(dir) / "sweep.json").string();
   const json mine = sweepRecord(spec);
   std::error_code ec;
@@ -70,6 +72,7 @@ void claimFolder(const SweepSpec& spec, const std::string& dir) {
       throw Error(fmt::format("{}: holds another sweep (its sweep.json differs from {}'s variants); give another "
                               "-o, or remove the folder",
                               dir, spec.file));
+    if (!rewrite) return;
   }
   writeTextFile(path, mine.dump(2) + "\n");
 }
@@ -188,32 +191,26 @@ void runJobs(const SweepSpec& spec, const std::string& dir, const std::vector<Jo
   }
 }
 
-}  // namespace
-
-int sweepCommand(const SweepOptions& o) {
-  SweepSpec spec = loadSweep(o.sweep);
-  if (o.frames >= 0) spec.frames = o.frames;
-  if (o.only >= int(spec.variants.size()))
-    throw Error(fmt::format("soak sweep: --only {}: the sweep has variants 0 to {}", o.only, spec.variants.size() - 1));
-  if (!o.quiet && !o.collect) std::printf("soak sweep: checking %zu variants of %s\n", spec.variants.size(), spec.scene.c_str());
-  if (!o.collect) checkSweepVariants(spec);
-  if (o.dryRun) {
-    for (const SweepVariant& v : spec.variants) std::printf("%s  %s\n", v.folder.c_str(), v.label().c_str());
-    return kExitOk;
-  }
-  claimFolder(spec, o.outDir);
+// the variants to run (one with --only; none with --collect), each with what it needs
+std::vector<Job> jobsToRun(const SweepSpec& spec, const SweepOptions& o) {
   std::vector<Job> jobs;
   for (size_t i = 0; i < spec.variants.size(); ++i) {
     if (o.collect || (o.only >= 0 && size_t(o.only) != i)) continue;
     const Need need = needOf((fs::path(o.outDir) / spec.variants[i].folder).string(), spec.frames);
     if (need != Need::Nothing) jobs.push_back({i, need});
   }
+  return jobs;
+}
+
+// runs the jobs here, N at a time, passing SIGINT / SIGTERM on to them
+void runHere(const SweepSpec& spec, const SweepOptions& o, const std::vector<Job>& jobs) {
   const int cores = o.threads > 0 ? o.threads : std::max(1, int(std::thread::hardware_concurrency()));
   const int parallel = std::max(1, std::min({o.jobs, int(std::max<size_t>(jobs.size(), 1)), cores}));
   const int threads = std::max(1, cores / parallel);
-  if (!o.quiet && !o.collect)
+  if (!o.quiet)
     std::printf("soak sweep: %zu to run (%zu complete), %d at a time with %d threads each, into %s\n", jobs.size(),
                 (o.only >= 0 ? size_t(1) : spec.variants.size()) - jobs.size(), parallel, threads, o.outDir.c_str());
+  if (jobs.empty()) return;
   struct sigaction sa {}, oldInt {}, oldTerm {};
   sa.sa_handler = onSweepSignal;
   sigemptyset(&sa.sa_mask);
@@ -222,12 +219,42 @@ int sweepCommand(const SweepOptions& o) {
   runJobs(spec, o.outDir, jobs, parallel, threads, o.quiet);
   sigaction(SIGINT, &oldInt, nullptr);
   sigaction(SIGTERM, &oldTerm, nullptr);
-  const SweepTotals totals = writeSweepSummary(spec, o.outDir, o.quiet);
-  if (gSweepStop != 0) return 128 + int(gSweepStop);
-  if (o.only >= 0)  // one task of an array: its own variant decides
+}
+
+}  // namespace
+
+int sweepCommand(const SweepOptions& o) {
+  SweepSpec spec = loadSweep(o.sweep);
+  if (o.frames >= 0) spec.frames = o.frames;
+  if (o.only >= int(spec.variants.size()))
+    throw Error(fmt::format("soak sweep: --only {}: the sweep has variants 0 to {}", o.only, spec.variants.size() - 1));
+  if (!o.collect) {
+    if (!o.quiet) std::printf("soak sweep: checking %s of %s\n", o.only >= 0 ? spec.variants[size_t(o.only)].folder.c_str()
+                                                                     : fmt::format("{} variants", spec.variants.size()).c_str(),
+                              spec.scene.c_str());
+    checkSweepVariants(spec, o.only);
+  }
+  if (o.dryRun && !o.slurm) {
+    for (const SweepVariant& v : spec.variants) std::printf("%s  %s\n", v.folder.c_str(), v.label().c_str());
+    return kExitOk;
+  }
+  claimFolder(spec, o.outDir, o.only < 0);
+  const std::vector<Job> jobs = jobsToRun(spec, o);
+  if (o.slurm) {
+    std::vector<size_t> todo;
+    for (const Job& j : jobs) todo.push_back(j.variant);
+    return submitSweep(spec, o, todo);
+  }
+  if (!o.collect) runHere(spec, o, jobs);
+  const int stopped = gSweepStop != 0 ? 128 + int(gSweepStop) : 0;
+  if (o.only >= 0) {  // one task of an array: its own variant decides; the summary is --collect's
+    if (stopped != 0) return stopped;
     return needOf((fs::path(o.outDir) / spec.variants[size_t(o.only)].folder).string(), spec.frames) == Need::Nothing
                ? kExitOk
                : kExitError;
+  }
+  const SweepTotals totals = writeSweepSummary(spec, o.outDir, o.quiet);
+  if (stopped != 0) return stopped;
   return totals.complete == int(spec.variants.size()) ? kExitOk : kExitError;
 }
 

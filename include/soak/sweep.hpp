@@ -36,8 +36,9 @@ inline constexpr int kMaxSweepVariants = 10000;
 // all with the same keys). Throws soak::Error naming the file, the JSON path and what was expected.
 SweepSpec loadSweep(const std::string& path);
 
-// loads the base scene with each variant's values (as `soak validate` would) so that a bad key or
-// value is reported, with the variant, before anything runs. Throws soak::Error.
-void checkSweepVariants(const SweepSpec& spec);
+// loads the base scene with each variant's values (as `soak validate` would; only variant `only`
+// when it is >= 0) so that a bad key or value is reported, with the variant, before anything runs.
+// Throws soak::Error.
+void checkSweepVariants(const SweepSpec& spec, int only = -1);
 
 }  // namespace soak

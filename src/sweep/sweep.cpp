@@ -169,8 +169,9 @@ SweepSpec loadSweep(const std::string& path) {
   return spec;
 }
 
-void checkSweepVariants(const SweepSpec& spec) {
+void checkSweepVariants(const SweepSpec& spec, int only) {
   for (const SweepVariant& v : spec.variants) {
+    if (only >= 0 && &v != &spec.variants[size_t(only)]) continue;
     std::vector<std::string> overrides = spec.common;
     for (const std::string& o : v.overrides()) overrides.push_back(o);
     try {

@@ -183,3 +183,25 @@ TEST(CliSweep, SigtermInterruptsTheVariantsAndTheNextSweepResumesThem) {
     EXPECT_HAS(readTextFile(f.out + "/" + v + ".log"), "--- soak sweep: resumed from the checkpoint ---");
   }
 }
+
+// --slurm --dry-run writes the job array script for the variants still to run, and submits nothing
+TEST(CliSweep, SlurmScriptHasATaskPerVariantStillToRun) {
+  const SweepFixture f("sbatch", kGrid);
+  ASSERT_EQ(f.run("--only 1 -q").code, 0);
+  const Result r = f.run("--slurm --dry-run --partition short --time 0:30:00 --cpus-per-task 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_HAS(r.out, "sweep.sbatch (3 tasks); submit it with: sbatch ");
+  const std::string script = readTextFile(f.out + "/sweep.sbatch");
+  EXPECT_EQ(script.substr(0, 12), "#!/bin/bash\n");
+  EXPECT_HAS(script, "\n#SBATCH --array=0,2-3\n");
+  EXPECT_HAS(script, "\n#SBATCH --cpus-per-task=2\n");
+  EXPECT_HAS(script, "\n#SBATCH --time=0:30:00\n");
+  EXPECT_HAS(script, "\n#SBATCH --partition=short\n");
+  EXPECT_HAS(script, "\n#SBATCH --output=" + f.out + "/slurm-%A_%a.out\n");
+  EXPECT_HAS(script, " sweep " + f.sweep + " -o " + f.out + " --frames 2 --only \"$SLURM_ARRAY_TASK_ID\" --threads \"${SLURM_CPUS_PER_TASK:-2}\" -q\n");
+  // what cannot go on an #SBATCH line is refused
+  const Result bad = f.run("--slurm --dry-run --partition 'a b'");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_HAS(bad.err, "expected no space, quote, backslash or control character");
+  EXPECT_NE(f.run("--partition short").code, 0);  // a Slurm option without --slurm
+}
