@@ -71,6 +71,7 @@ struct SweepOptions {
   int only = -1;        // run only this variant (a Slurm array task); -1: every one
   bool collect = false; // run nothing: measure the folders and write the summary
   bool dryRun = false;  // list the variants and stop; with slurm: write the script, submit nothing
+  bool sheet = true;    // draw the contact sheet after the summary
   bool quiet = false;
   // --slurm: an sbatch job array, one task per variant to run, instead of running here
   bool slurm = false;

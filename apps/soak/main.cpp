@@ -74,6 +74,7 @@ CLI::App* addSweepCommand(CLI::App& app, SweepOptions& sweep) {
       ->excludes(only);
   cmd->add_flag("--dry-run", sweep.dryRun, "check the variants, list them and stop (with --slurm: write the script only)");
   cmd->add_flag("-q,--quiet", sweep.quiet, "no progress lines");
+  cmd->add_flag("!--no-contact-sheet", sweep.sheet, "write the summary without drawing DIR/contact_sheet.png");
   CLI::Option* slurm = cmd->add_flag("--slurm", sweep.slurm,
                                      "submit a Slurm job array (sbatch), one task per variant still to run, instead "
                                      "of running here; DIR must be on a file system the nodes share")

@@ -255,6 +255,10 @@ int sweepCommand(const SweepOptions& o) {
   }
   const SweepTotals totals = writeSweepSummary(spec, o.outDir, o.quiet);
   if (stopped != 0) return stopped;
+  if (o.sheet && totals.complete > 0) {
+    const std::string sheet = writeSweepSheet(spec, o.outDir, o.quiet);
+    if (!o.quiet) std::printf("soak sweep: contact sheet %s\n", sheet.c_str());
+  }
   return totals.complete == int(spec.variants.size()) ? kExitOk : kExitError;
 }
 

@@ -17,4 +17,9 @@ struct SweepTotals {
 // counts unless quiet
 SweepTotals writeSweepSummary(const SweepSpec& spec, const std::string& dir, bool quiet);
 
+// DIR/contact_sheet.png: each complete variant's spec.sheet.frame drawn by soak render (all with the
+// camera the first one chose), its folder and values under it; variants not complete get a blank
+// tile saying why. Returns the file's path; throws soak::Error (a missing povray or ffmpeg, ...)
+std::string writeSweepSheet(const SweepSpec& spec, const std::string& dir, bool quiet);
+
 }  // namespace soak::cli

@@ -118,4 +118,17 @@ std::pair<int, int> pngSize(const std::string& path);
 // as renderRun does for a missing or broken folder
 ViewSettings runView(const std::string& runDir);
 
+// one picture of a contact sheet: a PNG ("" for a blank tile) and the lines of text under it
+struct ContactTile {
+  std::string image;
+  std::vector<std::string> caption;
+};
+
+// writes the tiles as one PNG, `columns` to a row, each with its caption under it in black on
+// white (ffmpeg: pad, drawtext, xstack). Every image must have the size width x height. Throws
+// soak::Error: ffmpeg missing (with the Debian package), an image of another size, ffmpeg failing
+// (with the end of its log).
+void writeContactSheet(const std::vector<ContactTile>& tiles, int columns, int width, int height,
+                       const std::string& outPng, double timeoutSeconds = 300.0);
+
 }  // namespace soak

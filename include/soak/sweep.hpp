@@ -18,6 +18,14 @@ struct SweepVariant {
   std::string label() const;
 };
 
+// the contact sheet: one picture of each variant (soak render), labelled with its values
+struct SweepSheet {
+  int frame = -1;       // the frame pictured; -1: each variant's last
+  int columns = 0;      // pictures to a row; 0: about the square root of the count
+  int width = 480, height = 360;  // pixels of each picture
+  bool particles = false;         // water drawn as particles (faster) instead of its surface
+};
+
 struct SweepSpec {
   std::string file;                 // the SWEEP.json it was read from
   std::string scene;                // the base scene, resolved against the sweep file's folder
@@ -25,13 +33,14 @@ struct SweepSpec {
   int frames = -1;                  // frames per variant; -1: the scene's output.frames
   std::vector<std::string> keys;    // the swept keys, in the file's order
   std::vector<SweepVariant> variants;
+  SweepSheet sheet;                 // "contactSheet"
 };
 
 // the most variants one sweep may have
 inline constexpr int kMaxSweepVariants = 10000;
 
 // reads SWEEP.json: "scene" (a path, relative to the sweep file's folder), optional "set" (a list of
-// "key=value") and "frames", and either "axes" (key -> a list of values, or {"from", "to", "count",
+// "key=value"), "frames" and "contactSheet", and either "axes" (key -> a list of values, or {"from", "to", "count",
 // "log"}: every combination, the first key slowest) or "variants" (a list of {key: value} objects,
 // all with the same keys). Throws soak::Error naming the file, the JSON path and what was expected.
 SweepSpec loadSweep(const std::string& path);

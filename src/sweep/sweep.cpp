@@ -120,6 +120,30 @@ void readVariantList(const std::string& file, const Ordered& list, SweepSpec& sp
   }
 }
 
+// "contactSheet": {"frame", "columns", "width", "height", "particles"}, each optional
+SweepSheet readSheet(const std::string& file, const Ordered& o) {
+  if (!o.is_object()) fail(file, "contactSheet", "expected an object, got " + kindOf(o));
+  SweepSheet sheet;
+  const auto integer = [&](const char* key, int lo, int hi, int& out) {
+    if (!o.contains(key)) return;
+    if (!o[key].is_number_integer() || o[key].get<int64_t>() < lo || o[key].get<int64_t>() > hi)
+      fail(file, std::string("contactSheet.") + key, fmt::format("expected an integer in [{}, {}]", lo, hi));
+    out = static_cast<int>(o[key].get<int64_t>());
+  };
+  for (const auto& [k, v] : o.items())
+    if (k != "frame" && k != "columns" && k != "width" && k != "height" && k != "particles")
+      fail(file, "contactSheet." + k, "unknown key (known: frame, columns, width, height, particles)");
+  integer("frame", -1, 100000000, sheet.frame);
+  integer("columns", 0, kMaxSweepVariants, sheet.columns);
+  integer("width", 16, 4096, sheet.width);
+  integer("height", 16, 4096, sheet.height);
+  if (o.contains("particles")) {
+    if (!o["particles"].is_boolean()) fail(file, "contactSheet.particles", "expected true or false");
+    sheet.particles = o["particles"].get<bool>();
+  }
+  return sheet;
+}
+
 }  // namespace
 
 std::vector<std::string> SweepVariant::overrides() const {
@@ -137,8 +161,9 @@ SweepSpec loadSweep(const std::string& path) {
   const Ordered doc = Ordered::parse(text, nullptr, true, true);
   if (!doc.is_object()) fail(path, "", "expected a JSON object at the top level, got " + kindOf(doc));
   for (const auto& [k, v] : doc.items())
-    if (k != "scene" && k != "set" && k != "frames" && k != "axes" && k != "variants" && k != "description")
-      fail(path, k, "unknown key (known: scene, set, frames, axes, variants, description)");
+    if (k != "scene" && k != "set" && k != "frames" && k != "axes" && k != "variants" && k != "description" &&
+        k != "contactSheet")
+      fail(path, k, "unknown key (known: scene, set, frames, axes, variants, contactSheet, description)");
   SweepSpec spec;
   spec.file = path;
   if (!doc.contains("scene") || !doc["scene"].is_string() || doc["scene"].get<std::string>().empty())
@@ -160,6 +185,7 @@ SweepSpec loadSweep(const std::string& path) {
       fail(path, "frames", "expected an integer in [0, 100000000]");
     spec.frames = static_cast<int>(doc["frames"].get<int64_t>());
   }
+  if (doc.contains("contactSheet")) spec.sheet = readSheet(path, doc["contactSheet"]);
   if (doc.contains("axes") == doc.contains("variants"))
     fail(path, "", "expected either \"axes\" (every combination) or \"variants\" (a list), not both or neither");
   if (doc.contains("axes")) readAxes(path, doc["axes"], spec);

@@ -3,6 +3,8 @@
 // not stop the others; --only, --collect, --dry-run; bad sweep files refused before anything runs
 #include "io/cli_support.hpp"
 
+#include <soak/render.hpp>
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -26,7 +28,10 @@ struct SweepFixture {
       : cli(name), scene(cli.writeScene("tiny.json", kTinyScene)),
         sweep(cli.writeScene("sweep.json", R"({"scene": "tiny.json", "frames": )" + std::to_string(frames) + ", " + body + "}")),
         out((cli.dir() / "out").string()) {}
-  Result run(const std::string& options = "") const { return cli.run("sweep '" + sweep + "' -o '" + out + "' " + options); }
+  // the contact sheet (POV-Ray, ffmpeg) only where a test asks for it
+  Result run(const std::string& options = "", bool sheet = false) const {
+    return cli.run("sweep '" + sweep + "' -o '" + out + "' " + options + (sheet ? "" : " --no-contact-sheet"));
+  }
   nlohmann::json summary() const { return nlohmann::json::parse(readTextFile(out + "/summary.json")); }
   nlohmann::json runJson(const std::string& v) const { return nlohmann::json::parse(readTextFile(out + "/" + v + "/run.json")); }
 };
@@ -204,4 +209,18 @@ TEST(CliSweep, SlurmScriptHasATaskPerVariantStillToRun) {
   EXPECT_EQ(bad.code, 1);
   EXPECT_HAS(bad.err, "expected no space, quote, backslash or control character");
   EXPECT_NE(f.run("--partition short").code, 0);  // a Slurm option without --slurm
+}
+
+// the contact sheet: each variant's last frame, 2 x 2 for 4 variants, each picture with its folder
+// and values under it (3 lines); the variant that failed gets a blank tile
+TEST(CliSweep, TheContactSheetHasAPicturePerVariant) {
+  const SweepFixture f("sheet", R"("contactSheet": {"width": 64, "height": 48, "particles": true},
+      "variants": [{"solver.maxSpeed": 50}, {"solver.maxSpeed": 1e-4}, {"solver.maxSpeed": 20}, {"solver.maxSpeed": 30}])");
+  const Result r = f.run("--jobs 2", true);
+  EXPECT_EQ(r.code, 1) << r.out << r.err;  // one diverged
+  EXPECT_HAS(r.out, "contact sheet " + f.out + "/contact_sheet.png");
+  for (const char* v : {"v000", "v002", "v003"}) EXPECT_TRUE(fs::exists(f.out + "/" + v + "/sheet/frame_0002.png")) << v;
+  EXPECT_FALSE(fs::exists(f.out + "/v001/sheet"));
+  // two columns of 64 pixels; two rows of 48 pixels and a caption band of 2 lines (18 px) + 2 x 6 px
+  EXPECT_EQ(pngSize(f.out + "/contact_sheet.png"), (std::pair{128, 2 * (48 + 2 * 18 + 12)}));
 }

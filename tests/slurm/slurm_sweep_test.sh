@@ -106,7 +106,7 @@ if [ -n "$(squeue --noheader --jobs="$job" --states=PENDING 2> /dev/null)" ] && 
 fi
 [ -z "$(squeue --noheader --jobs="$job" 2> /dev/null)" ] || fail "job $job still running after 120 s: $(squeue)"
 ls "$out"/slurm-"$job"_*.out > /dev/null 2>&1 || fail "the array tasks wrote no Slurm output"
-"$soak" sweep "$work/sweep.json" -o "$out" --collect || fail "soak sweep --collect: not every variant complete
+"$soak" sweep "$work/sweep.json" -o "$out" --collect --no-contact-sheet || fail "soak sweep --collect: not every variant complete
 $(cat "$out"/summary.csv; cat "$out"/slurm-*.out "$out"/v*.log 2> /dev/null)"
 /usr/bin/python3 - "$out/summary.json" << 'EOF' || fail "the summary is not what the sweep ran"
 import json, sys
