@@ -70,15 +70,17 @@ CLI::App* addSweepCommand(CLI::App& app, SweepOptions& sweep) {
       ->check(CLI::Range(0, 100000000));
   CLI::Option* only = cmd->add_option("--only", sweep.only, "run only variant I (0-based; a Slurm array task)")
                           ->check(CLI::Range(0, soak::kMaxSweepVariants - 1));
-  cmd->add_flag("--collect", sweep.collect, "run nothing: measure the variants' folders and write the summary")
-      ->excludes(only);
+  CLI::Option* collect = cmd->add_flag("--collect", sweep.collect,
+                                       "run nothing: measure the variants' folders and write the summary")
+                             ->excludes(only);
   cmd->add_flag("--dry-run", sweep.dryRun, "check the variants, list them and stop (with --slurm: write the script only)");
   cmd->add_flag("-q,--quiet", sweep.quiet, "no progress lines");
   cmd->add_flag("!--no-contact-sheet", sweep.sheet, "write the summary without drawing DIR/contact_sheet.png");
   CLI::Option* slurm = cmd->add_flag("--slurm", sweep.slurm,
                                      "submit a Slurm job array (sbatch), one task per variant still to run, instead "
                                      "of running here; DIR must be on a file system the nodes share")
-                           ->excludes(only);
+                           ->excludes(only)
+                           ->excludes(collect);
   const auto sbatchValue = [](const std::string& v) { return soak::cli::sbatchValueProblem(v); };
   cmd->add_option("--partition", sweep.partition, "with --slurm: the partition (default: the cluster's)")
       ->check(sbatchValue)
