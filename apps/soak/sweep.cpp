@@ -24,6 +24,7 @@
 #include <fstream>
 #include <map>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -84,15 +85,33 @@ void appendLine(const std::string& path, const std::string& line) {
   if (!out) throw Error(path + ": cannot write the variant's log");
 }
 
-// what a variant's folder needs: nothing (complete), a resume from its checkpoint, or a (new) run
-enum class Need { Nothing, Resume, Run };
+// DIR/vNNN.lock is held (flock) by the sweep process whose child runs variant NNN: another sweep on
+// the same folder (a second terminal, an array submitted again) leaves a held variant alone, and a
+// variant whose sweep died (the lock goes with the process) is taken up again. The descriptor, or -1
+// when another process holds it
+int tryLock(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(fmt::format("{}: cannot open the variant's lock: {}", path, std::strerror(errno)));
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return fd;
+  ::close(fd);
+  return -1;
+}
+
+// what a variant's folder needs: nothing (complete), nothing now (another sweep runs it), a resume
+// from its checkpoint, or a (new) run
+enum class Need { Nothing, Busy, Resume, Run };
 
 Need needOf(const std::string& folder, int frames) {
   std::error_code ec;
   if (!fs::exists(folder, ec)) return Need::Run;
+  const int lock = tryLock(folder + ".lock");
+  if (lock < 0) return Need::Busy;
+  ::close(lock);
   const RunSummary s = summarizeRun(folder);
   if (s.status == "ok" && (frames < 0 || s.framesWritten == frames + 1)) return Need::Nothing;
-  if (s.status == "interrupted" && fs::exists(fs::path(folder) / "checkpoint.soak", ec)) return Need::Resume;
+  // interrupted, or killed without a word (its run.json still says running): on from its checkpoint
+  if ((s.status == "interrupted" || s.status == "running") && fs::exists(fs::path(folder) / "checkpoint.soak", ec))
+    return Need::Resume;
   return Need::Run;
 }
 
@@ -146,6 +165,7 @@ struct Job {
 struct Running {
   size_t variant;
   std::chrono::steady_clock::time_point start;
+  int lock;  // its DIR/vNNN.lock, held until it ends
 };
 
 // runs the jobs `jobs` at a time; prints a line as each ends; stops starting new ones on a signal
@@ -160,9 +180,14 @@ void runJobs(const SweepSpec& spec, const std::string& dir, const std::vector<Jo
       const Job& j = jobs[next++];
       const SweepVariant& v = spec.variants[j.variant];
       const std::string folder = (fs::path(dir) / v.folder).string();
+      const int lock = tryLock(folder + ".lock");
+      if (lock < 0) {  // taken since needOf looked
+        if (!quiet) std::printf("soak sweep: %s is being run by another sweep; left alone\n", v.folder.c_str());
+        continue;
+      }
       if (j.need == Need::Resume) appendLine(folder + ".log", kResumeMark);
       const pid_t pid = spawnLogged(childArgs(spec, v, folder, j.need, threads), folder + ".log", j.need == Need::Resume);
-      running[pid] = {j.variant, std::chrono::steady_clock::now()};
+      running[pid] = {j.variant, std::chrono::steady_clock::now(), lock};
     }
     if (running.empty()) break;
     if (gSweepStop != 0 && !forwarded) {  // once: a second signal would stop them without a checkpoint
@@ -179,6 +204,7 @@ void runJobs(const SweepSpec& spec, const std::string& dir, const std::vector<Jo
     if (it == running.end()) continue;
     const SweepVariant& v = spec.variants[it->second.variant];
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
+    ::close(it->second.lock);
     running.erase(it);
     ++done;
     if (!quiet) {
@@ -197,7 +223,9 @@ std::vector<Job> jobsToRun(const SweepSpec& spec, const SweepOptions& o) {
   for (size_t i = 0; i < spec.variants.size(); ++i) {
     if (o.collect || (o.only >= 0 && size_t(o.only) != i)) continue;
     const Need need = needOf((fs::path(o.outDir) / spec.variants[i].folder).string(), spec.frames);
-    if (need != Need::Nothing) jobs.push_back({i, need});
+    if (need == Need::Busy && !o.quiet)
+      std::printf("soak sweep: %s is being run by another sweep; left alone\n", spec.variants[i].folder.c_str());
+    if (need == Need::Resume || need == Need::Run) jobs.push_back({i, need});
   }
   return jobs;
 }

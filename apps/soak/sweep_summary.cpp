@@ -52,6 +52,7 @@ Row measure(const SweepSpec& spec, const SweepVariant& v, const std::string& dir
   const bool allFrames = spec.frames < 0 || row.run.framesWritten == spec.frames + 1;
   std::error_code ec;
   if (s == "ok" && allFrames) row.status = "complete";
+  else if (s == "ok") row.status = "pending";  // complete with fewer frames than asked now: runs again
   else if (s == "interrupted" || s == "diverged" || s == "running") row.status = s;
   else if (s == "missing" && !fs::exists(folder + ".log", ec)) row.status = "pending";
   else row.status = "failed";

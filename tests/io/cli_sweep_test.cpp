@@ -10,6 +10,7 @@
 #include <chrono>
 #include <csignal>
 #include <fcntl.h>
+#include <sys/file.h>
 #include <string>
 #include <thread>
 
@@ -223,4 +224,22 @@ TEST(CliSweep, TheContactSheetHasAPicturePerVariant) {
   EXPECT_FALSE(fs::exists(f.out + "/v001/sheet"));
   // two columns of 64 pixels; two rows of 48 pixels and a caption band of 2 lines (18 px) + 2 x 6 px
   EXPECT_EQ(pngSize(f.out + "/contact_sheet.png"), (std::pair{128, 2 * (48 + 2 * 18 + 12)}));
+}
+
+// a variant another sweep runs (its DIR/vNNN.lock held) is left alone; once the lock is free it runs
+TEST(CliSweep, AVariantLockedByAnotherSweepIsLeftAlone) {
+  const SweepFixture f("lock", kGrid);
+  fs::create_directories(f.out);
+  const int fd = ::open((f.out + "/v000.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  const Result r = f.run("--jobs 2");
+  EXPECT_EQ(r.code, 1) << r.out << r.err;  // not every variant is complete
+  EXPECT_HAS(r.out, "v000 is being run by another sweep; left alone");
+  EXPECT_HAS(r.out, "3 complete, 0 failed, 0 interrupted, 1 pending");
+  EXPECT_FALSE(fs::exists(f.out + "/v000"));
+  ::close(fd);
+  const Result again = f.run();
+  EXPECT_EQ(again.code, 0) << again.out << again.err;
+  EXPECT_HAS(again.out, "1 to run (3 complete)");
 }
