@@ -107,7 +107,7 @@ Need needOf(const std::string& folder, int frames) {
   const int lock = tryLock(folder + ".lock");
   if (lock < 0) return Need::Busy;
   ::close(lock);
-  const RunSummary s = summarizeRun(folder);
+  const RunSummary s = runStatus(folder);
   if (s.status == "ok" && (frames < 0 || s.framesWritten == frames + 1)) return Need::Nothing;
   // interrupted, or killed without a word (its run.json still says running): on from its checkpoint
   if ((s.status == "interrupted" || s.status == "running") && fs::exists(fs::path(folder) / "checkpoint.soak", ec))

@@ -43,9 +43,10 @@ std::string writeSweepSheet(const SweepSpec& spec, const std::string& dir, bool 
     ContactTile tile;
     tile.caption.push_back(v.folder);
     for (const std::string& o : v.overrides()) tile.caption.push_back(o);
-    const RunSummary s = summarizeRun(runDir);
-    const int frame = sh.frame >= 0 ? sh.frame : s.frame;
-    if (s.status != "ok" || frame < 0 || frame > s.frame) {
+    const RunSummary s = runStatus(runDir);
+    const int last = s.framesWritten - 1;
+    const int frame = sh.frame >= 0 ? sh.frame : last;
+    if (s.status != "ok" || frame < 0 || frame > last) {
       tile.caption.front() += fmt::format(" ({}: not drawn)", s.status == "ok" ? "no such frame" : s.status);
       tiles.push_back(tile);
       continue;

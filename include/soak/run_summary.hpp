@@ -21,4 +21,8 @@ struct RunSummary {
 // run.json gives status "missing" and nothing measured; a damaged file throws soak::Error naming it.
 RunSummary summarizeRun(const std::string& dir);
 
+// only run.json's status and framesWritten (nothing measured): what a sweep needs to know whether a
+// variant is complete, without loading its scene
+RunSummary runStatus(const std::string& dir);
+
 }  // namespace soak

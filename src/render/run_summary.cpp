@@ -73,7 +73,7 @@ void measureCloth(const RunOutput& run, int frame, RunSummary& s) {
 
 }  // namespace
 
-RunSummary summarizeRun(const std::string& dir) {
+RunSummary runStatus(const std::string& dir) {
   RunSummary s;
   const std::string record = (fs::path(dir) / "run.json").string();
   std::error_code ec;
@@ -81,6 +81,11 @@ RunSummary summarizeRun(const std::string& dir) {
   const nlohmann::json j = parseFile(record, readTextFile(record));
   s.status = j.value("status", "missing");
   s.framesWritten = j.contains("framesWritten") && j["framesWritten"].is_number_integer() ? j["framesWritten"].get<int>() : 0;
+  return s;
+}
+
+RunSummary summarizeRun(const std::string& dir) {
+  RunSummary s = runStatus(dir);
   if (s.framesWritten <= 0) return s;
   s.frame = s.framesWritten - 1;
   readStats((fs::path(dir) / "stats.jsonl").string(), s.frame, s);
