@@ -78,6 +78,7 @@ struct SweepOptions {
   std::string partition;  // empty: the cluster's default
   std::string time;       // a task's time limit in sbatch's format; empty: the partition's
   int cpusPerTask = 1;    // each task's CPUs (its soak run threads)
+  bool wait = false;      // wait for the job array, then write the summary (as --collect would)
 };
 
 int runCommand(const RunOptions& o);

@@ -91,6 +91,8 @@ CLI::App* addSweepCommand(CLI::App& app, SweepOptions& sweep) {
   cmd->add_option("--cpus-per-task", sweep.cpusPerTask, "with --slurm: each task's CPUs, its threads (default 1)")
       ->check(CLI::Range(1, soak::kMaxThreads))
       ->needs(slurm);
+  cmd->add_flag("--wait", sweep.wait, "with --slurm: wait until the job array is done, then write the summary")
+      ->needs(slurm);
   return cmd;
 }
 

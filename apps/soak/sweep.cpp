@@ -45,6 +45,27 @@ extern "C" void onSweepSignal(int sig) {
   std::signal(sig, SIG_DFL);  // a second signal stops at once
 }
 
+// SIGINT and SIGTERM set gSweepStop while it lives (no SA_RESTART: a wait returns EINTR)
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction sa {};
+    sa.sa_handler = onSweepSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &oldInt_);
+    sigaction(SIGTERM, &sa, &oldTerm_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &oldInt_, nullptr);
+    sigaction(SIGTERM, &oldTerm_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction oldInt_ {}, oldTerm_ {};
+};
+
 // the expanded sweep as DIR/sweep.json: what a later `soak sweep` on DIR must match to resume it
 json sweepRecord(const SweepSpec& spec) {
   json variants = json::array();
@@ -239,14 +260,8 @@ void runHere(const SweepSpec& spec, const SweepOptions& o, const std::vector<Job
     std::printf("soak sweep: %zu to run (%zu complete), %d at a time with %d threads each, into %s\n", jobs.size(),
                 (o.only >= 0 ? size_t(1) : spec.variants.size()) - jobs.size(), parallel, threads, o.outDir.c_str());
   if (jobs.empty()) return;
-  struct sigaction sa {}, oldInt {}, oldTerm {};
-  sa.sa_handler = onSweepSignal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, &oldInt);
-  sigaction(SIGTERM, &sa, &oldTerm);
+  const StopSignals guard;
   runJobs(spec, o.outDir, jobs, parallel, threads, o.quiet);
-  sigaction(SIGINT, &oldInt, nullptr);
-  sigaction(SIGTERM, &oldTerm, nullptr);
 }
 
 }  // namespace
@@ -271,9 +286,16 @@ int sweepCommand(const SweepOptions& o) {
   if (o.slurm) {
     std::vector<size_t> todo;
     for (const Job& j : jobs) todo.push_back(j.variant);
-    return submitSweep(spec, o, todo);
+    const std::string job = submitSweep(spec, o, todo);
+    if (!o.wait || job.empty()) return kExitOk;
+    const StopSignals guard;
+    if (!waitForJob(job, gSweepStop)) {  // the job goes on: --collect later
+      std::printf("soak sweep: stopped waiting; job %s goes on (soak sweep ... --collect when it is done)\n", job.c_str());
+      return 128 + int(gSweepStop);
+    }
+  } else if (!o.collect) {
+    runHere(spec, o, jobs);
   }
-  if (!o.collect) runHere(spec, o, jobs);
   const int stopped = gSweepStop != 0 ? 128 + int(gSweepStop) : 0;
   if (o.only >= 0) {  // one task of an array: its own variant decides; the summary is --collect's
     if (stopped != 0) return stopped;

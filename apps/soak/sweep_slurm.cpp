@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace soak::cli {
 
@@ -67,17 +68,17 @@ std::string sbatchScript(const SweepSpec& spec, const SweepOptions& o, const std
   return s;
 }
 
-int submitSweep(const SweepSpec& spec, const SweepOptions& o, const std::vector<size_t>& todo) {
+std::string submitSweep(const SweepSpec& spec, const SweepOptions& o, const std::vector<size_t>& todo) {
   if (todo.empty()) {
     if (!o.quiet) std::printf("soak sweep: every variant is complete; nothing to submit\n");
-    return kExitOk;
+    return {};
   }
   const std::string script = (fs::path(o.outDir) / "sweep.sbatch").string();
   writeTextFile(script, sbatchScript(spec, o, todo));
   if (o.dryRun) {
     std::printf("soak sweep: wrote %s (%zu tasks); submit it with: sbatch %s\n", script.c_str(), todo.size(),
                 joinCommandLine({script}).c_str());
-    return kExitOk;
+    return {};
   }
   std::string out;
   const int code = capture("sbatch --parsable " + joinCommandLine({script}), out);
@@ -85,9 +86,26 @@ int submitSweep(const SweepSpec& spec, const SweepOptions& o, const std::vector<
   if (code != 0)
     throw Error(fmt::format("soak sweep: sbatch {} failed (exit code {}): {}{}", script, code, out,
                             code == 127 ? " (install Slurm's client, Debian's slurm-client, or run without --slurm)" : ""));
-  std::printf("soak sweep: submitted job %s, %zu tasks (%s); when it is done: %s --collect\n", out.c_str(), todo.size(),
-              arraySpec(todo).c_str(), joinCommandLine({"soak", "sweep", spec.file, "-o", o.outDir}).c_str());
-  return kExitOk;
+  if (o.wait)
+    std::printf("soak sweep: submitted job %s, %zu tasks (%s); waiting for it\n", out.c_str(), todo.size(),
+                arraySpec(todo).c_str());
+  else
+    std::printf("soak sweep: submitted job %s, %zu tasks (%s); when it is done: %s --collect\n", out.c_str(),
+                todo.size(), arraySpec(todo).c_str(), joinCommandLine({"soak", "sweep", spec.file, "-o", o.outDir}).c_str());
+  std::fflush(stdout);
+  return out;
+}
+
+bool waitForJob(const std::string& job, const volatile std::sig_atomic_t& stop) {
+  while (stop == 0) {
+    std::string out;
+    // squeue fails once the job has left its records: gone as well
+    if (capture("squeue --noheader --jobs=" + joinCommandLine({job}), out) != 0 ||
+        out.find_first_not_of(" \t\r\n") == std::string::npos)
+      return true;
+    for (int i = 0; i < 20 && stop == 0; ++i) ::usleep(250000);  // 5 s, a signal ends it sooner
+  }
+  return false;
 }
 
 }  // namespace soak::cli

@@ -119,4 +119,10 @@ assert all(x["heldWaterKg"] > 0 for x in v), v  # the block landed on the cloth 
 # more absorption holds more water, at either substep count
 assert v[1]["heldWaterKg"] > v[0]["heldWaterKg"] and v[3]["heldWaterKg"] > v[2]["heldWaterKg"], v
 EOF
-echo "soak sweep ran 4 variants through Slurm job $job"
+# --wait: one frame more for every variant (so all four run again), submitted, waited for, summarised
+timeout 120 "$soak" sweep "$work/sweep.json" -o "$out" --slurm --wait --frames 11 --no-contact-sheet |
+  tee "$work/wait.txt" || fail "soak sweep --slurm --wait did not end with every variant complete"
+grep -q "waiting for it" "$work/wait.txt" && grep -q "4 complete, 0 failed" "$work/wait.txt" ||
+  fail "soak sweep --slurm --wait said: $(cat "$work/wait.txt")"
+grep -q '"framesWritten": 12' "$out/v003/run.json" || fail "v003 was not run to frame 11: $(cat "$out/v003/run.json")"
+echo "soak sweep ran 4 variants through Slurm job $job, and again with --wait"
