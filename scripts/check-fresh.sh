@@ -96,6 +96,8 @@ cp /etc/hosts "$root/etc/hosts"
 
 mount -t proc proc "$root/proc" && mounted+=("$root/proc")
 mount -t tmpfs tmpfs "$root/dev/shm" && mounted+=("$root/dev/shm")
+# /sys with its cgroup mount, as a machine has it: slurmd (tests/slurm/) will not start without it
+mount --rbind /sys "$root/sys" && mount --make-rslave "$root/sys" && mounted+=("$root/sys")
 
 git clone --quiet --no-hardlinks "$repo" "$root/work/soak"
 echo "check-fresh: a clean clone of $(git -C "$repo" rev-parse --short HEAD) is in /work/soak of the root"

@@ -9,9 +9,14 @@ cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 # the fuzz targets are built before the suite, which runs them briefly (77: clang's fuzzer runtime missing)
 ./scripts/fuzz.sh --build || [[ $? -eq 77 ]]
+# why a test was skipped: the line it printed ("SKIPPED: ..." or "soak: fuzz: skipped: ...") in
+# ctest's log, since ctest shows only that it was
+skipped() { grep -hE "^SKIPPED: |: skipped: " "$1/Testing/Temporary/LastTest.log" 2> /dev/null || true; }
 ctest --test-dir build --output-on-failure -j "$(nproc)"
+skipped build
 if [[ "${SOAK_SKIP_PORTABLE:-0}" != 1 ]]; then
   cmake -S . -B build-portable -G Ninja -DCMAKE_BUILD_TYPE=Release -DSOAK_NATIVE=OFF
   cmake --build build-portable -j "$(nproc)"
   ctest --test-dir build-portable --output-on-failure -j "$(nproc)"
+  skipped build-portable
 fi
