@@ -113,14 +113,13 @@ void fillBuffers(const Model& model, State& state, const WettingScratch& s) {
   // EW_i = max(0, (S_i - S^EW) V_i) / c; then S_i as computeSaturation, in the same loop. A buffer
   // holding m^threshold (a drip that found no place, under water) takes no more, from its particle or
   // from above (moveBuffersDown), so a sheet under water does not pump the pool into its buffers
-  // (departure: docs/models.md). m^threshold is per referenceArea of cloth: times the particle's areaShare
-  const double full = static_cast<double>(w.massThreshold);
+  // (departure: docs/models.md). m^threshold is per referenceArea of cloth (dripThreshold)
   std::vector<float>& sat = state.clothSaturation;
   sat.resize(static_cast<size_t>(nc));
   parallelFor(nc, [&](int64_t i) {
     const double keep = static_cast<double>(w.saturationEmit) * s.volume[i] / c;
     const double excess = state.clothWater[i] - keep;
-    if (excess > 0.0 && state.clothBuffer[i] < full * s.areaShare[i]) {  // a full buffer takes no more (below)
+    if (excess > 0.0 && state.clothBuffer[i] < dripThreshold(w, s.areaShare[i])) {  // a full buffer takes no more (below)
       state.clothWater[i] = keep;
       state.clothBuffer[i] += excess;
     }
@@ -216,7 +215,6 @@ void outflowScales(const Model& model, const NeighborLists& nb, const FlowInputs
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
-  const double full = static_cast<double>(w.massThreshold);
   const uint32_t* const indexAll = in.indexAll;
   const int32_t* const phaseAll = in.phaseAll;
   const float* const volumeAll = in.volumeAll;
@@ -236,15 +234,16 @@ void outflowScales(const Model& model, const NeighborLists& nb, const FlowInputs
     const int32_t phu = P[u];
     const float vu = volumeAll[u];
     const double* const B = bufferAll;
-    const double bu = bufferAll[u], rateL = rate, fullL = full;
+    const double bu = bufferAll[u], rateL = rate;
     const float* const A = s.areaShare.data();
+    const float thr = w.massThreshold;  // a local: the loop below is vectorised
 #pragma omp simd
     for (uint32_t k = 0; k < count; ++k) {
       const uint32_t l = J[k];
       const bool same = (l < clothL) & (P[l] == phu);
       const uint32_t ll = same ? l : static_cast<uint32_t>(u);  // buffers hold cloth only
       const float cosLU = -C[k];  // cosGravity(x_l, x_u, g)
-      const bool below = same & (cosLU > 0.0f) & (B[ll] < fullL * A[ll]);  // and l's buffer takes water
+      const bool below = same & (cosLU > 0.0f) & (B[ll] < dripThreshold(thr, A[ll]));  // and l's buffer takes water
       T[k] = bufferFlow(rateL, cosLU, vu, W[k], bu) * (below ? 1.0 : 0.0);  // +-0 where not below
     }
     double out = 0.0;
@@ -261,7 +260,6 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
   const WettingParams& w = model.wetting;
   const int64_t nc = model.numCloth;
   const uint32_t cloth = static_cast<uint32_t>(nc);
-  const double full = static_cast<double>(w.massThreshold);
   const uint32_t* const indexAll = in.indexAll;
   const int32_t* const phaseAll = in.phaseAll;
   const float* const volumeAll = in.volumeAll;
@@ -291,8 +289,9 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
     const uint32_t clothL = cloth;
     const int32_t phk = P[k];
     const float vk = VL[k], osk = OS[k];
-    const double bk = B[k], rateL = rate, fullL = full, fullK = full * s.areaShare[k];
+    const double bk = B[k], rateL = rate, fullK = dripThreshold(w, s.areaShare[k]);
     const float* const A = s.areaShare.data();
+    const float thr = w.massThreshold;  // a local: the loop below is vectorised
 #pragma omp simd
     for (uint32_t e = 0; e < count; ++e) {
       const uint32_t j = J[e];
@@ -301,7 +300,7 @@ void netFlows(const Model& model, const NeighborLists& nb, const FlowInputs& in,
       const float cosKJ = C[e];  // > 0: k below j; cos theta_jk is exactly -cosKJ
       const float osj = OS[jj];
       const bool fromJ = same & (cosKJ > 0.0f) & (osj > 0.0f) & (bk < fullK);     // j sheds into k
-      const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < fullL * A[jj]);   // k sheds into j
+      const bool toJ = same & (cosKJ < 0.0f) & (osk > 0.0f) & (B[jj] < dripThreshold(thr, A[jj]));   // k sheds into j
       // outScale_u bufferFlow(u -> l)
       const double in = static_cast<double>(osj) * bufferFlow(rateL, cosKJ, VL[jj], W[e], B[jj]);
       const double out = static_cast<double>(osk) * bufferFlow(rateL, -cosKJ, vk, W[e], bk);
@@ -336,8 +335,7 @@ void moveBuffersDown(const Model& model, State& state, const NeighborLists& nb, 
 // 4a. the drips still hanging: kept in state.dripId / dripSource and in s.dripOf (the drip of each
 // source, -1: none), each fed from its source's buffer up to maxDrip (at least the source's m^threshold)
 void feedHangingDrips(const Model& model, State& state, WettingScratch& s, float maxDrip) {
-  const float threshold = model.wetting.massThreshold;
-  const auto largest = [&](int64_t src) { return std::max(maxDrip, threshold * s.areaShare[src]); };
+  const auto largest = [&](int64_t src) { return std::max(maxDrip, dripThreshold(model.wetting, s.areaShare[src])); };
   const int64_t nc = model.numCloth;
   Particles& p = state.particles;
   const float m0 = model.water.particleMass, h0 = model.water.supportRadius;
@@ -383,7 +381,7 @@ size_t placeNewDrips(const Model& model, State& state, const NeighborLists& nb, 
   const float m0 = model.water.particleMass, h0 = model.water.supportRadius, rho0 = model.water.restDensity;
   const std::vector<int64_t>& dripOf = s.dripOf;
   const size_t gridSize = grid.cellEntries.size();
-  const auto dripMass = [&](int32_t i) { return w.massThreshold * s.areaShare[static_cast<size_t>(i)]; };
+  const auto dripMass = [&](int32_t i) { return dripThreshold(w, s.areaShare[static_cast<size_t>(i)]); };
   const auto dripRadius = [&](int32_t i) { return std::cbrt(dripMass(i) / m0) * h0; };  // h_p = (m_p / m0)^(1/3) h0
   // a place inside a collider (below a sheet lying on the floor or on a ball) would be pushed out at
   // the next substep, through the far side of a thin floor or flung off the ball (departure: docs/models.md)

@@ -228,6 +228,11 @@ inline float areaShare(float referenceArea, float restArea) {
   return referenceArea > 0.0f ? restArea / referenceArea : 1.0f;
 }
 
+// kg, the m^threshold of a cloth particle of that share: a buffer this full makes a drip of this mass
+// and takes no more water
+inline float dripThreshold(float massThreshold, float share) { return massThreshold * share; }
+inline float dripThreshold(const WettingParams& w, float share) { return dripThreshold(w.massThreshold, share); }
+
 // sticking.cpp ------------------------------------------------------------------------------------
 
 // Eq. 20 coefficient of a touching pair, N: (eta^ad - kappa^ad |(S_i - S^T)(S_j - S^T)|)+, times a
