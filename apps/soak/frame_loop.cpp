@@ -1,4 +1,5 @@
 #include "frame_loop.hpp"
+#include "stop_signals.hpp"
 
 #include "commands.hpp"
 #include "progress.hpp"
@@ -19,36 +20,6 @@ namespace soak::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-// the signal that asked the run to stop (0: none); the handler only sets it
-volatile std::sig_atomic_t gStopSignal = 0;
-
-extern "C" void onStopSignal(int sig) {
-  gStopSignal = sig;
-  std::signal(sig, SIG_DFL);  // a second signal stops at once
-}
-
-// SIGINT and SIGTERM set gStopSignal while the loop runs; the previous handlers come back after it
-class StopSignals {
- public:
-  StopSignals() {
-    gStopSignal = 0;
-    struct sigaction sa {};
-    sa.sa_handler = onStopSignal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &oldInt_);
-    sigaction(SIGTERM, &sa, &oldTerm_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &oldInt_, nullptr);
-    sigaction(SIGTERM, &oldTerm_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction oldInt_ {}, oldTerm_ {};
-};
 
 nlohmann::ordered_json waterJson(const WaterMass& w, const State& s) {
   return {{"freeKg", w.free},

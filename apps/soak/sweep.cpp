@@ -3,6 +3,7 @@
 // checkpoint; then the summary table (sweep_summary.cpp). docs/sweeps.md
 #include "commands.hpp"
 #include "sweep_slurm.hpp"
+#include "stop_signals.hpp"
 #include "sweep_summary.hpp"
 
 #include <soak/error.hpp>
@@ -37,34 +38,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
-
-volatile std::sig_atomic_t gSweepStop = 0;  // the signal that asked the sweep to stop (0: none)
-
-extern "C" void onSweepSignal(int sig) {
-  gSweepStop = sig;
-  std::signal(sig, SIG_DFL);  // a second signal stops at once
-}
-
-// SIGINT and SIGTERM set gSweepStop while it lives (no SA_RESTART: a wait returns EINTR)
-class StopSignals {
- public:
-  StopSignals() {
-    struct sigaction sa {};
-    sa.sa_handler = onSweepSignal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &oldInt_);
-    sigaction(SIGTERM, &sa, &oldTerm_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &oldInt_, nullptr);
-    sigaction(SIGTERM, &oldTerm_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction oldInt_ {}, oldTerm_ {};
-};
 
 // the expanded sweep as DIR/sweep.json: what a later `soak sweep` on DIR must match to resume it
 json sweepRecord(const SweepSpec& spec) {
@@ -197,7 +170,7 @@ void runJobs(const SweepSpec& spec, const std::string& dir, const std::vector<Jo
   size_t next = 0, done = 0;
   bool forwarded = false;
   while (next < jobs.size() || !running.empty()) {
-    while (gSweepStop == 0 && next < jobs.size() && running.size() < size_t(parallel)) {
+    while (gStopSignal == 0 && next < jobs.size() && running.size() < size_t(parallel)) {
       const Job& j = jobs[next++];
       const SweepVariant& v = spec.variants[j.variant];
       const std::string folder = (fs::path(dir) / v.folder).string();
@@ -211,8 +184,8 @@ void runJobs(const SweepSpec& spec, const std::string& dir, const std::vector<Jo
       running[pid] = {j.variant, std::chrono::steady_clock::now(), lock};
     }
     if (running.empty()) break;
-    if (gSweepStop != 0 && !forwarded) {  // once: a second signal would stop them without a checkpoint
-      for (const auto& r : running) kill(r.first, int(gSweepStop));
+    if (gStopSignal != 0 && !forwarded) {  // once: a second signal would stop them without a checkpoint
+      for (const auto& r : running) kill(r.first, int(gStopSignal));
       forwarded = true;
     }
     int status = 0;
@@ -289,14 +262,14 @@ int sweepCommand(const SweepOptions& o) {
     const std::string job = submitSweep(spec, o, todo);
     if (!o.wait || job.empty()) return kExitOk;
     const StopSignals guard;
-    if (!waitForJob(job, gSweepStop)) {  // the job goes on: --collect later
+    if (!waitForJob(job, gStopSignal)) {  // the job goes on: --collect later
       std::printf("soak sweep: stopped waiting; job %s goes on (soak sweep ... --collect when it is done)\n", job.c_str());
-      return 128 + int(gSweepStop);
+      return 128 + int(gStopSignal);
     }
   } else if (!o.collect) {
     runHere(spec, o, jobs);
   }
-  const int stopped = gSweepStop != 0 ? 128 + int(gSweepStop) : 0;
+  const int stopped = gStopSignal != 0 ? 128 + int(gStopSignal) : 0;
   if (o.only >= 0) {  // one task of an array: its own variant decides; the summary is --collect's
     if (stopped != 0) return stopped;
     return needOf((fs::path(o.outDir) / spec.variants[size_t(o.only)].folder).string(), spec.frames) == Need::Nothing
