@@ -102,7 +102,7 @@ Need needOf(const std::string& folder, int frames) {
   if (lock < 0) return Need::Busy;
   ::close(lock);
   const RunSummary s = runStatus(folder);
-  if (s.status == "ok" && (frames < 0 || s.framesWritten == frames + 1)) return Need::Nothing;
+  if (runComplete(s, frames)) return Need::Nothing;
   // interrupted, or killed without a word (its run.json still says running): on from its checkpoint
   if ((s.status == "interrupted" || s.status == "running") && fs::exists(fs::path(folder) / "checkpoint.soak", ec))
     return Need::Resume;

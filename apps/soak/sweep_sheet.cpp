@@ -46,8 +46,9 @@ std::string writeSweepSheet(const SweepSpec& spec, const std::string& dir, bool 
     const RunSummary s = runStatus(runDir);
     const int last = s.framesWritten - 1;
     const int frame = sh.frame >= 0 ? sh.frame : last;
-    if (s.status != "ok" || frame < 0 || frame > last) {
-      tile.caption.front() += fmt::format(" ({}: not drawn)", s.status == "ok" ? "no such frame" : s.status);
+    if (!runComplete(s, spec.frames) || frame > last) {
+      const std::string why = !runComplete(s, spec.frames) ? (s.status == "ok" ? "fewer frames" : s.status) : "no such frame";
+      tile.caption.front() += fmt::format(" ({}: not drawn)", why);
       tiles.push_back(tile);
       continue;
     }

@@ -49,9 +49,8 @@ Row measure(const SweepSpec& spec, const SweepVariant& v, const std::string& dir
     return {"failed", e.what(), {}};
   }
   const std::string& s = row.run.status;
-  const bool allFrames = spec.frames < 0 || row.run.framesWritten == spec.frames + 1;
   std::error_code ec;
-  if (s == "ok" && allFrames) row.status = "complete";
+  if (runComplete(row.run, spec.frames)) row.status = "complete";
   else if (s == "ok") row.status = "pending";  // complete with fewer frames than asked now: runs again
   else if (s == "interrupted" || s == "diverged" || s == "running") row.status = s;
   else if (s == "missing" && !fs::exists(folder + ".log", ec)) row.status = "pending";
@@ -107,6 +106,10 @@ std::string csvTable(const SweepSpec& spec, const json& rows) {
 }
 
 }  // namespace
+
+bool runComplete(const RunSummary& s, int frames) {
+  return s.status == "ok" && (frames < 0 || s.framesWritten == frames + 1);
+}
 
 SweepTotals writeSweepSummary(const SweepSpec& spec, const std::string& dir, bool quiet) {
   SweepTotals t;

@@ -1,5 +1,6 @@
 // soak sweep's summary: DIR/summary.json and DIR/summary.csv, one row per variant (docs/sweeps.md)
 #pragma once
+#include <soak/run_summary.hpp>
 #include <soak/sweep.hpp>
 
 #include <string>
@@ -8,6 +9,10 @@ namespace soak::cli {
 
 // the line a variant's log gets before each resume: its error is what follows the last one
 inline constexpr const char* kResumeMark = "--- soak sweep: resumed from the checkpoint ---";
+
+// a variant's run is complete: run.json says ok, with the frames the sweep asks for (frames < 0: the
+// scene's own, whatever run.json counts)
+bool runComplete(const RunSummary& s, int frames);
 
 struct SweepTotals {
   int complete = 0, failed = 0, interrupted = 0, pending = 0;  // pending: not started, or running

@@ -19,10 +19,10 @@ namespace fs = std::filesystem;
 
 constexpr int kFontSize = 14, kLineHeight = 18, kMargin = 6;
 
-// one tile's chain: the picture (or white), taller by the caption band, and one drawtext per line
-// (read from a file in the work folder, so no caption text is parsed as filter syntax)
-std::string tileChain(size_t i, int input, int band, int lines) {
-  std::string chain = fmt::format("[{}:v]pad=iw:ih+{}:0:0:color=white", input, band);
+// tile i's chain from input i: the picture (or white), taller by the caption band, and one drawtext
+// per line (read from a file in the work folder, so no caption text is parsed as filter syntax)
+std::string tileChain(size_t i, int band, int lines) {
+  std::string chain = fmt::format("[{}:v]pad=iw:ih+{}:0:0:color=white", i, band);
   for (int l = 0; l < lines; ++l)
     chain += fmt::format(",drawtext=textfile=c{}_{}.txt:expansion=none:fontsize={}:fontcolor=black:x={}:y=h-{}", i, l,
                          kFontSize, kMargin, band - kMargin - l * kLineHeight);
@@ -48,7 +48,6 @@ void writeContactSheet(const std::vector<ContactTile>& tiles, int columns, int w
   // inputs: the pictures, then one white picture for every blank tile and empty cell
   std::vector<std::string> args = {ffmpeg, "-hide_banner", "-loglevel", "error", "-y"};
   std::string graph, stack;
-  int input = 0;
   const std::string blank = fmt::format("color=c=white:s={}x{}", width, height);
   for (size_t i = 0; i < cells; ++i) {
     const ContactTile empty;
@@ -57,11 +56,11 @@ void writeContactSheet(const std::vector<ContactTile>& tiles, int columns, int w
     else args.insert(args.end(), {"-i", fs::absolute(t.image).string()});
     for (size_t l = 0; l < t.caption.size(); ++l)
       writeTextFile((work / fmt::format("c{}_{}.txt", i, l)).string(), t.caption[l]);
-    graph += tileChain(i, input++, band, int(t.caption.size())) + ";";
+    graph += tileChain(i, band, int(t.caption.size()));
     stack += fmt::format("[t{}]", i);
+    if (i + 1 < cells) graph += ";";
   }
-  graph += fmt::format("{}xstack=inputs={}:grid={}x{}[out]", stack, cells, columns, rows);
-  if (cells == 1) graph = graph.substr(0, graph.rfind(';')) ;  // one tile: no stack
+  if (cells > 1) graph += fmt::format(";{}xstack=inputs={}:grid={}x{}[out]", stack, cells, columns, rows);
   const std::string out = fs::absolute(outPng).string();
   args.insert(args.end(), {"-filter_complex", graph, "-map", cells == 1 ? "[t0]" : "[out]", "-frames:v", "1", out});
   const std::string log = (work / "ffmpeg.log").string();

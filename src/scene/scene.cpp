@@ -243,7 +243,7 @@ void checkDripThreshold(ErrorLog& log, const Model& model, const std::vector<flo
     for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
       const float share = areaShare(w.referenceArea, model.clothRestArea[size_t(i)]);
       if (share > 0.0f) {
-        hold.push_back(double(w.saturationMax) * volume[size_t(i)] / w.c / share);
+        hold.push_back(mostHeldWater(w, volume[size_t(i)]) / share);
         continue;
       }
       log.error("wetting.referenceArea",

@@ -472,7 +472,8 @@ size_t emitExcessWater(const Model& model, State& state, const NeighborLists& nb
 }
 
 // f_p = sum_i kappa^e (m_i + eta^e S_i) (Psi_i / rho0) W(x_ip, h_p) along x_i - x_p (Eq. 19), Psi_i =
-// rho0 V_i (NOTES.md); kappa^e in m/s^2 and eta^e in kg make it newtons. The kernel's support h_p grows
+// rho0 V_i (NOTES.md); kappa^e in m/s^2 and eta^e in kg make it newtons (eta^e per referenceArea of
+// cloth: times the particle's areaShare). The kernel's support h_p grows
 // with the drip, so its peak falls as 1/m_p while the drip's weight rises: a heavy drip falls.
 void applyDripAttraction(const Model& model, State& state, const NeighborLists& nb, const WettingScratch& s, float h) {
   const WettingParams& w = model.wetting;
