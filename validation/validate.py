@@ -80,7 +80,7 @@ def rest(work):
     The density solve stops at a 1% mean compression (solver.fluidTolerance); what kinetic energy it
     leaves is particle-scale noise spread through the block, which grows the further the solve goes
     (8, 16, 32, 64 fixed iterations: 0.020, 0.018, 0.050, 0.12 J at 3 s; 4: 0.24 J, 2.9% compressed):
-    docs/models.md, "Eq. 6-7 iterated to a tolerance", says why and what was tried."""
+    docs/models.md, "Eq. 6-7 iterated to a tolerance", has the measurements and what was tried."""
     out = soakrun.run(os.path.join(HERE, "rest_block.json"), os.path.join(work, "rest"))
     t, ke, rho, its = [], [], [], []
     for s, w in water_frames(out):
