@@ -71,6 +71,7 @@ struct GarmentParams {
   float rayleighBeta = 3.81413e-3f;   // s, stiffness-proportional damping (Eq. 22)
   float cgTolerance = 1e-4f;          // relative preconditioned residual
   int cgMaxIterations = 300;
+  bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
 };
 
 }  // namespace soak

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 namespace soak {
@@ -162,6 +163,26 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
   });
 }
 
+// Fig. 5's skin friction of vertex v (piece-local) at time tEnd: wet from wetStart[v] (none: dry)
+float fabricFriction(const GarmentParams& params, std::span<const float> wetStart, int v, double tEnd) {
+  const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
+  return wetFriction(tEnd - static_cast<double>(start), params.friction);
+}
+
+// a vertex at x touching collider c along its outward normal nrm: the velocity into the collider is
+// removed and Coulomb friction (the fabric's mixed with the collider's) acts on the slip, with the
+// removed normal velocity as its impulse; x gives back the slip friction removed during the step
+void contactResponse(const Collider& collider, const ColliderPose& pose, const Vec3& nrm, float muFabric, float h,
+                     Vec3& x, Vec3& vel) {
+  const Vec3 vCol = pose.velocityAt(x);
+  Vec3 rel = vel - vCol;
+  const float dvn = std::max(-rel.dot(nrm), 0.0f);
+  rel += dvn * nrm;  // the inward velocity is removed
+  const Vec3 after = coulombFriction(rel, nrm, mixFriction(muFabric, collider.friction), dvn);
+  x += h * (after - rel);  // friction acted during the step: the slip it removed is not travelled
+  vel = vCol + after;
+}
+
 // v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then contact with the colliders at time + h, with
 // the fabric's wet friction; marks the vertices in contact with 3 in w.constrained
 void integrateWithContact(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
@@ -185,8 +206,7 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
       p.xPred[i] = x;
       return;
     }
-    const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
-    const float muFabric = wetFriction(tEnd - static_cast<double>(start), params.friction);
+    const float muFabric = fabricFriction(params, wetStart, static_cast<int>(v), tEnd);
     bool contact = false;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm;
@@ -194,19 +214,59 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
       if (d >= 0.0f) continue;
       contact = true;
       x -= d * nrm;  // project out to the margin
-      const Vec3 vCol = poses[c].velocityAt(x);
-      Vec3 rel = vel - vCol;
-      const float vn = rel.dot(nrm);
-      const float dvn = std::max(-vn, 0.0f);
-      rel += dvn * nrm;  // the inward velocity is removed
-      const Vec3 after = coulombFriction(rel, nrm, mixFriction(muFabric, model.colliders[c].friction), dvn);
-      x += h * (after - rel);  // friction acted during the step: the slip it removed is not travelled
-      vel = vCol + after;
+      contactResponse(model.colliders[c], poses[c], nrm, muFabric, h, x, vel);
     }
     p.xPred[i] = x;
     p.v[i] = vel;
     if (contact) touched[v] = 3;
   });
+}
+
+// contact of the mesh edges between the vertices (garment.edgeContact): a body part narrower than an
+// edge, or a curve of one, passes between two vertices that are both outside it. Each edge's midpoint
+// within the margin of a collider is moved out to it along the normal, the edge's free vertices alike
+// (one free vertex moves twice as far, so the midpoint still reaches the margin), and their velocity
+// into the collider is removed (no friction: the vertices' own contact has it). Gauss-Seidel over the
+// edges in spring order, serial: the same result for any thread count. Only edges whose midpoint's
+// distance lower bound (colliderDistanceBounds, vectorised) is under twice the margin are visited (a
+// neighbour's push moves a midpoint by about the margin). Returns the edges pushed.
+int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, Particles& p,
+                 ImplicitScratch& w) {
+  const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
+  const size_t first = static_cast<size_t>(g.firstParticle);
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  const int edges = g.springs.kindStart[1];  // the stretch springs: every mesh edge
+  if (numColliders == 0 || edges == 0) return 0;
+  Vec3* x = p.xPred.data() + first;
+  Vec3* v = p.v.data() + first;
+  w.edgeMid.resize(static_cast<size_t>(edges));
+  w.edgeBound.assign(static_cast<size_t>(edges), std::numeric_limits<float>::max());
+  for (int e = 0; e < edges; ++e) w.edgeMid[e] = 0.5f * (x[g.springs.ids[e][0]] + x[g.springs.ids[e][1]]);
+  for (size_t c = 0; c < numColliders; ++c)
+    colliderDistanceBounds(model.colliders[c], poses[c], w.edgeMid[0].data(), edges, w.edgeBound.data());
+  const auto moves = [&](int u) { return w.constrained[u] != 1 && w.constrained[u] != 2; };  // not pinned, not disturbed
+  int pushed = 0;
+  for (int e = 0; e < edges; ++e) {
+    if (w.edgeBound[e] >= 2.0f * margin) continue;
+    const int a = g.springs.ids[e][0], b = g.springs.ids[e][1];
+    const bool ma = moves(a), mb = moves(b);
+    if (!ma && !mb) continue;
+    for (size_t c = 0; c < numColliders; ++c) {
+      const Vec3 mid = 0.5f * (x[a] + x[b]);
+      Vec3 nrm;
+      const float d = colliderDistance(model.colliders[c], poses[c], mid, &nrm) - margin;
+      if (d >= 0.0f) continue;
+      const Vec3 push = -d * nrm * (ma && mb ? 1.0f : 2.0f);
+      for (const auto& [u, free] : {std::pair{a, ma}, std::pair{b, mb}}) {
+        if (!free) continue;
+        x[u] += push;
+        const Vec3 vCol = poses[c].velocityAt(x[u]);
+        v[u] -= std::min((v[u] - vCol).dot(nrm), 0.0f) * nrm;  // the velocity into the collider is removed
+      }
+      ++pushed;
+    }
+  }
+  return pushed;
 }
 
 }  // namespace
@@ -228,6 +288,7 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   stats.converged = cg.converged;
   stats.breakdown = cg.breakdown;
   integrateWithContact(model, g, params, time, h, poses, wetStart, p, w);
+  if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;
   return stats;
 }

@@ -59,6 +59,8 @@ struct ImplicitScratch {
   std::vector<float> strain;
   std::vector<Vec3d> rhs, dv;
   std::vector<uint8_t> constrained;
+  std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
+  std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
 };
 
 struct ImplicitStats {
@@ -68,6 +70,7 @@ struct ImplicitStats {
   bool breakdown = false;    // the system was not positive definite
   int constrainedVertices = 0;  // pinned + disturbed
   int contacts = 0;             // vertices pushed out of a collider
+  int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider
   int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)
   float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
 };

@@ -79,6 +79,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.unconverged += r.converged ? 0 : 1;
     gs.breakdowns += r.breakdown ? 1 : 0;
     gs.contacts += static_cast<uint64_t>(r.contacts);
+    gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
   }
   if (!model.hasImplicitCloth()) return;

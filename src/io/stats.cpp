@@ -85,6 +85,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"unconvergedSolves", g.unconverged},
                     {"breakdowns", g.breakdowns},
                     {"contacts", g.contacts},
+                    {"edgeContacts", g.edgeContacts},
                     {"disturbances", g.disturbances},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},

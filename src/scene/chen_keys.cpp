@@ -95,6 +95,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
     g.rayleighAlpha = ray.number("alpha", d.rayleighAlpha, Range::nonNegative());
   g.rayleighBeta = ray.number("beta", d.rayleighBeta, Range::nonNegative());
   ray.finish();
+  g.edgeContact = r.boolean("edgeContact", d.edgeContact);
   ObjectReader cg = r.object("cg");
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());
   g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));

@@ -351,6 +351,37 @@ TEST(GarmentRun, GarmentDoesNotPenetrateTheMannequin) {
   EXPECT_GT(lowest, 0.6);
 }
 
+// the deepest point of the shirt's edges and triangles in the body: the lowest body distance of the
+// edge midpoints and triangle centroids
+float deepestBetweenVertices(const Scene& s) {
+  const Model& m = s.model;
+  const auto& x = s.state.particles.x;
+  float worst = 1e30f;
+  for (const auto& t : m.triangles) {
+    worst = std::min(worst, bodyDistance(m.colliders, s.state.time, (x[t[0]] + x[t[1]] + x[t[2]]) / 3.0f, nullptr));
+    for (int e = 0; e < 3; ++e)
+      worst = std::min(worst, bodyDistance(m.colliders, s.state.time, 0.5f * (x[t[e]] + x[t[(e + 1) % 3]]), nullptr));
+  }
+  return worst;
+}
+
+// garment.edgeContact: the body no longer passes between two vertices of the shirt (without it the
+// arms and shoulders cut through edges by centimetres while every vertex stays outside)
+TEST(GarmentRun, EdgeContactKeepsTheBodyOutOfTheEdgesAndTriangles) {
+  const std::string path = std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_dry.json";
+  Scene off = loadScene(path, {"cloth.0.mesh.edgeLength=0.045"});
+  Scene on = loadScene(path, {"cloth.0.mesh.edgeLength=0.045", "cloth.0.garment.edgeContact=true"});
+  StepStats total;
+  run(off.model, off.state, 60);  // 1 s
+  run(on.model, on.state, 60, &total);
+  const float thickness = on.model.pieces[0].material.thickness;
+  EXPECT_LT(deepestBetweenVertices(off), -0.01f);  // the test sees what the option removes
+  EXPECT_GT(deepestBetweenVertices(on), -0.25f * thickness);  // centroids are not pushed: within the cloth's thickness
+  EXPECT_GT(total.garment.edgeContacts, 0u);
+  for (int i = 0; i < on.model.numCloth; ++i)
+    EXPECT_GT(bodyDistance(on.model.colliders, on.state.time, on.state.particles.x[size_t(i)], nullptr), -thickness);
+}
+
 TEST(GarmentRun, SameStateForOneAndTwoThreads) {
   auto hashWith = [](int threads) {
     setThreadCount(threads);
