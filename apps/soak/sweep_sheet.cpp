@@ -46,8 +46,9 @@ std::string writeSweepSheet(const SweepSpec& spec, const std::string& dir, bool 
     const RunSummary s = runStatus(runDir);
     const int last = s.framesWritten - 1;
     const int frame = sh.frame >= 0 ? sh.frame : last;
-    if (!runComplete(s, spec.frames) || frame > last) {
-      const std::string why = !runComplete(s, spec.frames) ? (s.status == "ok" ? "fewer frames" : s.status) : "no such frame";
+    const bool complete = runComplete(s, spec.frames);
+    if (!complete || frame > last) {
+      const std::string why = !complete ? (s.status == "ok" ? "fewer frames" : s.status) : "no such frame";
       tile.caption.front() += fmt::format(" ({}: not drawn)", why);
       tiles.push_back(tile);
       continue;

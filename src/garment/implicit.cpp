@@ -163,12 +163,6 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
   });
 }
 
-// Fig. 5's skin friction of vertex v (piece-local) at time tEnd: wet from wetStart[v] (none: dry)
-float fabricFriction(const GarmentParams& params, std::span<const float> wetStart, int v, double tEnd) {
-  const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
-  return wetFriction(tEnd - static_cast<double>(start), params.friction);
-}
-
 // a vertex at x touching collider c along its outward normal nrm: the velocity into the collider is
 // removed and Coulomb friction (the fabric's mixed with the collider's) acts on the slip, with the
 // removed normal velocity as its impulse; x gives back the slip friction removed during the step
@@ -206,7 +200,8 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
       p.xPred[i] = x;
       return;
     }
-    const float muFabric = fabricFriction(params, wetStart, static_cast<int>(v), tEnd);
+    const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
+    const float muFabric = wetFriction(tEnd - static_cast<double>(start), params.friction);
     bool contact = false;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm;
@@ -260,8 +255,7 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
       for (const auto& [u, free] : {std::pair{a, ma}, std::pair{b, mb}}) {
         if (!free) continue;
         x[u] += push;
-        const Vec3 vCol = poses[c].velocityAt(x[u]);
-        v[u] -= std::min((v[u] - vCol).dot(nrm), 0.0f) * nrm;  // the velocity into the collider is removed
+        contactResponse(model.colliders[c], poses[c], nrm, 0.0f, 0.0f, x[u], v[u]);  // frictionless: no slip removed
       }
       ++pushed;
     }
