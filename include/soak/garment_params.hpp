@@ -34,16 +34,17 @@ struct SaturationParams {
   float delta = 0.84f;     // kg of water per kg of dry fabric at saturation (Table 1's "theta" row, see NOTES.md)
   float a3 = 8.844f;       // time constant of Eq. 18, in the paper's (unstated) time unit
   float timeScale = 1.0f;  // s of simulated time per paper time unit: t_paper = t / timeScale (default: seconds)
+  bool unlimitedSupply = false;  // Chen as printed: a wet vertex absorbs Q(t) from its first touch; false: it
+                                 // absorbs the water that reached it (State::clothWater), at Eq. 18's rate
 };
 
-// wet skin friction of Fig. 5 (wet_friction.hpp)
+// wet skin friction of Fig. 5 over the saturation s = absorbed water / (delta m_dry) (wet_friction.hpp)
 struct WetFrictionParams {
-  float dry = 0.35f;      // Coulomb coefficient before the fabric is wet
-  float peak = 0.60f;     // at tau1
-  float plateau = 0.45f;  // from tau2 on
-  float tau1 = 2.0f;      // paper time units (scaled by timeScale like Eq. 18's a3), > 0
-  float tau2 = 6.0f;      // > tau1
-  float timeScale = 1.0f; // s of simulated time per paper time unit
+  float dry = 0.35f;               // Coulomb coefficient of the dry fabric (s = 0)
+  float peak = 0.60f;              // at s = peakSaturation
+  float plateau = 0.45f;           // from s = plateauSaturation on
+  float peakSaturation = 0.2f;     // in (0, 1)
+  float plateauSaturation = 0.5f;  // in (peakSaturation, 1]
 };
 
 // wrinkle disturbances of section 3.5 (wrinkles.hpp)
@@ -55,7 +56,8 @@ struct WrinkleParams {
   int patchSize = 100;                 // vertices per subdomain when the garment has no panels
   float tieTolerance = 1e-3f;          // |AA1| = |AA2| when they differ by less than this fraction of l0 (step 5)
   uint32_t seed = 1;                   // the paper's random choice between equal candidates, made reproducible
-  float strength = 1.0f;               // fraction of the way from A to the chosen point A' the vertex is moved, (0, 1]
+  float strength = 1.0f;               // fraction of the way from A to the chosen point A' a saturated vertex is moved, (0, 1]
+  float dryStrength = 0.0f;            // the same for a dry vertex, [0, strength]; linear in the saturation between
 };
 
 // everything the implicit garment solver of one cloth piece reads (implicit.hpp)

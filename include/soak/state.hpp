@@ -41,8 +41,8 @@ struct WaterLedger {
   double inBuffers = 0.0;          // kg, excess water in the emission buffers (section 4.4)
   uint64_t particlesAbsorbed = 0;  // water particles absorbed whole (Eq. 11)
   uint64_t dripsEmitted = 0;       // drip particles created from the buffers (section 4.4)
-  double takenByCloth = 0.0;       // kg, water particles that wetted a Chen 2012 piece and vanished into it
-  uint64_t particlesTakenByCloth = 0;
+  double takenByCloth = 0.0;       // kg, water particles that vanished into a Chen 2012 piece of unlimited supply
+  uint64_t particlesTakenByCloth = 0;  // particles taken by Chen pieces (into clothWater, or vanished)
 };
 
 struct EmitterState {
@@ -58,15 +58,16 @@ struct State {
   Particles particles;
   WaterLedger ledger;
   std::vector<EmitterState> emitters;
-  // cloth wetting (Shao 2017 section 4): one entry per cloth particle when model.wetting.enabled.
+  // cloth wetting (Shao 2017 section 4): one entry per cloth particle when model.wetting.enabled, or
+  // when a piece is wetted by contact (Chen 2012, below; clothBuffer then stays 0).
   // double for the water stores so the ledger closes to 1e-5 over long runs
-  std::vector<double> clothWater;      // kg held, m^water of Eq. 10
+  std::vector<double> clothWater;      // kg held, m^water of Eq. 10 (Chen: the drops a vertex took)
   std::vector<double> clothBuffer;     // kg of excess water waiting to drip, EW^buffer of section 4.4
-  std::vector<float> clothSaturation;  // S_i of Eq. 10 at the last wetting stage
+  std::vector<float> clothSaturation;  // S_i of Eq. 10 at the last wetting stage (Chen: s = Q / delta in [0, 1])
   std::vector<uint32_t> dripId;        // ids of the drips hanging from the cloth (Eq. 19), ascending
   std::vector<int32_t> dripSource;     // the cloth particle each drip hangs from
-  // Chen 2012 saturation mass and wet friction: the time each cloth particle first got wet
-  // (+infinity: dry); one entry per cloth particle when a piece has wetByContact, else empty
+  // Chen 2012: the time each cloth particle first got wet (+infinity: dry); one entry per cloth
+  // particle when a piece has wetByContact, else empty
   std::vector<float> clothWetStart;
   // PBF iterations the last substep took: the iterations to solver.fluidTolerance go below it only
   // with a margin (stopIterating, docs/models.md "Eq. 6-7 iterated to a tolerance")

@@ -40,9 +40,10 @@ void checkGarmentParams(const GarmentParams& p, const std::string& where) {
   require(f.dry >= 0.0f, where, "friction.dry", "a number >= 0", f.dry);
   require(f.peak >= 0.0f, where, "friction.peak", "a number >= 0", f.peak);
   require(f.plateau >= 0.0f, where, "friction.plateau", "a number >= 0", f.plateau);
-  require(f.tau1 > 0.0f, where, "friction.tau1", "a number > 0", f.tau1);
-  require(f.tau2 > f.tau1, where, "friction.tau2", fmt::format("a number > friction.tau1 ({})", f.tau1), f.tau2);
-  require(f.timeScale > 0.0f, where, "friction.timeScale", "a number > 0 (s)", f.timeScale);
+  require(f.peakSaturation > 0.0f && f.peakSaturation < 1.0f, where, "friction.peakSaturation", "a number in (0, 1)",
+          f.peakSaturation);
+  require(f.plateauSaturation > f.peakSaturation && f.plateauSaturation <= 1.0f, where, "friction.plateauSaturation",
+          fmt::format("a number in (friction.peakSaturation ({}), 1]", f.peakSaturation), f.plateauSaturation);
   require(p.rayleighAlpha >= 0.0f, where, "rayleighAlpha",
           "a number >= 0 (1/s; a negative alpha adds energy: the paper's -9 is a typo)", p.rayleighAlpha);
   require(p.rayleighBeta >= 0.0f, where, "rayleighBeta", "a number >= 0 (s)", p.rayleighBeta);
@@ -56,6 +57,9 @@ void checkGarmentParams(const GarmentParams& p, const std::string& where) {
   require(p.wrinkles.interval >= 1, where, "wrinkles.interval", "an integer >= 1", p.wrinkles.interval);
   require(p.wrinkles.strength > 0.0f && p.wrinkles.strength <= 1.0f, where, "wrinkles.strength", "a number in (0, 1]",
           p.wrinkles.strength);
+  require(p.wrinkles.dryStrength >= 0.0f && p.wrinkles.dryStrength <= p.wrinkles.strength, where,
+          "wrinkles.dryStrength", fmt::format("a number in [0, wrinkles.strength ({})]", p.wrinkles.strength),
+          p.wrinkles.dryStrength);
   require(p.wrinkles.patchSize >= 3, where, "wrinkles.patchSize", "an integer >= 3", p.wrinkles.patchSize);
 }
 
@@ -179,13 +183,12 @@ void contactResponse(const Collider& collider, const ColliderPose& pose, const V
 
 // v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then contact with the colliders at time + h, with
 // the fabric's wet friction; marks the vertices in contact with 3 in w.constrained
-void integrateWithContact(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
-                          const std::vector<ColliderPose>& poses, std::span<const float> wetStart, Particles& p,
+void integrateWithContact(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
+                          const std::vector<ColliderPose>& poses, std::span<const float> saturation, Particles& p,
                           ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
-  const double tEnd = time + static_cast<double>(h);
   std::vector<uint8_t>& touched = w.constrained;  // reused: 3 = in contact this step
   parallelFor(g.count, [&](int64_t v) {
     const size_t i = first + static_cast<size_t>(v);
@@ -200,8 +203,7 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
       p.xPred[i] = x;
       return;
     }
-    const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
-    const float muFabric = wetFriction(tEnd - static_cast<double>(start), params.friction);
+    const float muFabric = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
     bool contact = false;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm;
@@ -265,8 +267,8 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
 
 }  // namespace
 
-ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, double time, float h,
-                           const std::vector<ColliderPose>& poses, std::span<const float> wetStart,
+ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
+                           const std::vector<ColliderPose>& poses, std::span<const float> saturation,
                            const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
   ImplicitStats stats;
   const double hd = h;
@@ -281,19 +283,19 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   stats.cgResidual = cg.residual;
   stats.converged = cg.converged;
   stats.breakdown = cg.breakdown;
-  integrateWithContact(model, g, params, time, h, poses, wetStart, p, w);
+  integrateWithContact(model, g, params, h, poses, saturation, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;
   return stats;
 }
 
 ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
-                             std::span<const float> wetStart, double time, float h, uint64_t stepIndex,
+                             std::span<const float> saturation, float h, uint64_t stepIndex,
                              const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch) {
-  if (params.saturationMass) applySaturationMass(model, g.piece, wetStart, time, params.saturation, p);  // Eq. 15-19
-  const std::vector<PositionConstraint> wrinkles =
-      computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses, params.wrinkles, stepIndex);  // 3.5
-  ImplicitStats s = implicitStep(model, g, params, time, h, poses, wetStart, wrinkles, p, scratch);      // Eq. 1-5
+  if (params.saturationMass) applySaturationMass(model, g.piece, saturation, params.saturation, p);  // Eq. 15-19
+  const std::vector<PositionConstraint> wrinkles = computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses,
+                                                                       params.wrinkles, stepIndex, saturation);  // 3.5
+  ImplicitStats s = implicitStep(model, g, params, h, poses, saturation, wrinkles, p, scratch);  // Eq. 1-5
   s.disturbances = static_cast<int>(wrinkles.size());
   return s;
 }

@@ -56,19 +56,47 @@ double absorptionRate(double wetTime, const SaturationParams& s) {
   return s.delta / tau * std::exp(-wetTime / tau);  // Eq. 19
 }
 
-double wetMass(double dryMass, float wetStart, double time, const SaturationParams& s) {
-  if (!std::isfinite(wetStart)) return dryMass;
-  return dryMass * (1.0 + absorbedRatio(time - static_cast<double>(wetStart), s));
+float unlimitedSaturation(double wetTime, const SaturationParams& s) {
+  if (!(wetTime > 0.0) || !std::isfinite(wetTime)) return 0.0f;
+  return static_cast<float>(-std::expm1(-wetTime / (static_cast<double>(s.a3) * s.timeScale)));  // Eq. 18 / delta
 }
 
-void applySaturationMass(const Model& model, int piece, std::span<const float> wetStart, double time,
-                         const SaturationParams& s, Particles& p) {
+float absorbStep(float saturation, double heldFraction, double h, const SaturationParams& s) {
+  const double target = std::clamp(heldFraction, 0.0, 1.0);
+  if (!(target > saturation)) return saturation;  // absorbed water stays absorbed
+  const double tau = static_cast<double>(s.a3) * s.timeScale;
+  return static_cast<float>(saturation + (target - saturation) * -std::expm1(-h / tau));  // Eq. 18's ODE
+}
+
+double waterCapacity(double dryMass, const SaturationParams& s) { return static_cast<double>(s.delta) * dryMass; }
+
+double wetMass(double dryMass, float saturation, const SaturationParams& s) {
+  if (!(saturation > 0.0f)) return dryMass;
+  return dryMass * (1.0 + static_cast<double>(s.delta) * std::min(saturation, 1.0f));
+}
+
+void applySaturationMass(const Model& model, int piece, std::span<const float> saturation, const SaturationParams& s,
+                         Particles& p) {
   const ClothPiece& pc = model.pieces[static_cast<size_t>(piece)];
   parallelFor(pc.particleCount, [&](int64_t v) {
     const size_t i = static_cast<size_t>(pc.firstParticle + v);
-    const float start = static_cast<size_t>(v) < wetStart.size() ? wetStart[v] : kNeverWet;
-    const float m = static_cast<float>(wetMass(model.clothDryMass[i], start, time, s));
-    p.setMass(i, m, model.clothPinned[i]);
+    const float sat = static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f;
+    p.setMass(i, static_cast<float>(wetMass(model.clothDryMass[i], sat, s)), model.clothPinned[i]);
+  });
+}
+
+void updateSaturation(const Model& model, int piece, const SaturationParams& s, double time, float h, State& state) {
+  const ClothPiece& pc = model.pieces[static_cast<size_t>(piece)];
+  const double tEnd = time + static_cast<double>(h);
+  parallelFor(pc.particleCount, [&](int64_t v) {
+    const size_t i = static_cast<size_t>(pc.firstParticle + v);
+    float& sat = state.clothSaturation[i];
+    if (s.unlimitedSupply) {
+      sat = unlimitedSaturation(tEnd - static_cast<double>(state.clothWetStart[i]), s);
+      return;
+    }
+    const double capacity = waterCapacity(model.clothDryMass[i], s);
+    sat = absorbStep(sat, capacity > 0.0 ? state.clothWater[i] / capacity : 0.0, h, s);
   });
 }
 

@@ -5,16 +5,86 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <span>
 
 namespace soak {
 
 namespace {
 
-std::span<const float> pieceWetStart(const State& state, const ClothPiece& piece) {
-  if (state.clothWetStart.size() < static_cast<size_t>(piece.firstParticle + piece.particleCount)) return {};
-  return std::span<const float>(state.clothWetStart).subspan(static_cast<size_t>(piece.firstParticle),
-                                                             static_cast<size_t>(piece.particleCount));
+// each vertex's saturation in [0, 1] for the piece (piece-local): Chen's s = absorbed / (delta m_dry)
+// from State::clothSaturation, or with Shao's wetting on S / S^MAX; empty when the piece keeps none
+std::span<const float> pieceSaturation(const Model& model, const State& state, const ClothPiece& piece,
+                                       std::vector<float>& fraction) {
+  const size_t first = static_cast<size_t>(piece.firstParticle), n = static_cast<size_t>(piece.particleCount);
+  if (state.clothSaturation.size() < first + n) return {};
+  const std::span<const float> s = std::span<const float>(state.clothSaturation).subspan(first, n);
+  if (!model.wetting.enabled) return s;
+  fraction.resize(n);
+  const float inv = model.wetting.saturationMax > 0.0f ? 1.0f / model.wetting.saturationMax : 0.0f;
+  for (size_t v = 0; v < n; ++v) fraction[v] = std::min(s[v] * inv, 1.0f);
+  return fraction;
+}
+
+// the water a vertex still takes: unlimited supply always, else while it holds less than delta m_dry
+bool takesWater(const Model& model, const State& state, const ClothPiece& piece, int64_t i) {
+  if (!piece.wetByContact) return false;
+  const SaturationParams& sat = piece.garment.saturation;
+  return sat.unlimitedSupply || state.clothWater[size_t(i)] < waterCapacity(model.clothDryMass[size_t(i)], sat);
+}
+
+// each water particle's nearest cloth vertex within touch distance that takes water, or -1 (gather)
+void findTouches(const Model& model, const State& state, const NeighborLists& nb, std::vector<int32_t>& touch) {
+  const Particles& p = state.particles;
+  const int64_t n = static_cast<int64_t>(p.size()), nc = model.numCloth;
+  touch.assign(static_cast<size_t>(n), -1);
+  parallelFor(n - nc, [&](int64_t jj) {
+    const int64_t j = nc + jj;
+    float best = std::numeric_limits<float>::infinity();
+    int32_t hit = -1;
+    for (uint32_t e = nb.start[size_t(j)]; e < nb.start[size_t(j) + 1]; ++e) {
+      const int64_t i = nb.index[e];
+      if (i >= nc) continue;
+      const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[i]))];
+      if (!takesWater(model, state, piece, i)) continue;
+      const float d = (p.x[size_t(i)] - p.x[size_t(j)]).norm();
+      if (d < touchDistance(model, piece) && d < best) {
+        best = d;
+        hit = static_cast<int32_t>(i);
+      }
+    }
+    touch[size_t(j)] = hit;
+  });
+}
+
+// the touching particles go, in particle order (deterministic): into the vertex's water (held,
+// until it holds delta m_dry; a drop reaching a full vertex stays and runs off), or with an unlimited
+// supply and dropsVanish out of the simulation (counted in WaterLedger::takenByCloth)
+size_t takeTouchingWater(const Model& model, State& state, const std::vector<int32_t>& touch, float now,
+                         std::vector<uint8_t>& keep) {
+  Particles& p = state.particles;
+  const int64_t n = static_cast<int64_t>(p.size());
+  keep.assign(static_cast<size_t>(n), 1);
+  size_t taken = 0;
+  for (int64_t j = model.numCloth; j < n; ++j) {
+    const int32_t i = touch[size_t(j)];
+    if (i < 0) continue;
+    const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[i]))];
+    if (piece.garment.saturation.unlimitedSupply) {
+      if (!piece.dropsVanish) continue;
+      state.ledger.takenByCloth += p.mass[size_t(j)];
+    } else {
+      if (!takesWater(model, state, piece, i)) continue;  // filled by an earlier drop of this substep
+      state.clothWater[size_t(i)] += p.mass[size_t(j)];
+      if (!std::isfinite(state.clothWetStart[size_t(i)])) state.clothWetStart[size_t(i)] = now;
+    }
+    keep[size_t(j)] = 0;
+    ++taken;
+  }
+  state.ledger.particlesTakenByCloth += taken;
+  if (taken) p.compact(keep);
+  return taken;
 }
 
 }  // namespace
@@ -39,15 +109,11 @@ void buildGarmentPieces(Model& model) {
 
 std::vector<float> clothWetness(const Model& model, const State& state) {
   std::vector<float> wet(static_cast<size_t>(model.numCloth), 0.0f);
-  if (state.clothWetStart.size() != wet.size()) return wet;
+  std::vector<float> fraction;
   for (const ClothPiece& piece : model.pieces) {
     if (!piece.wetByContact) continue;
-    const SaturationParams& s = piece.garment.saturation;
-    for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
-      const float start = state.clothWetStart[size_t(i)];
-      if (!std::isfinite(start)) continue;
-      wet[size_t(i)] = s.delta > 0.0f ? static_cast<float>(absorbedRatio(state.time - start, s) / s.delta) : 1.0f;
-    }
+    const std::span<const float> s = pieceSaturation(model, state, piece, fraction);
+    std::copy(s.begin(), s.end(), wet.begin() + piece.firstParticle);
   }
   return wet;
 }
@@ -63,14 +129,16 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
   GarmentStats& gs = stats.garment;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];
-    const std::span<const float> wetStart = pieceWetStart(state, piece);
+    if (piece.wetByContact && !model.wetting.enabled && !state.clothSaturation.empty())
+      updateSaturation(model, static_cast<int>(k), piece.garment.saturation, state.time, h, state);  // Eq. 18
+    const std::span<const float> saturation = pieceSaturation(model, state, piece, s.fraction);
     if (piece.solver != ClothSolver::Implicit) {
       if (piece.garment.saturationMass)  // Eq. 15-19 on a PBD piece: heavier once wet
-        applySaturationMass(model, static_cast<int>(k), wetStart, state.time, piece.garment.saturation, p);
+        applySaturationMass(model, static_cast<int>(k), saturation, piece.garment.saturation, p);
       continue;
     }
     if (!piece.implicit) continue;  // a Model built without the loader's buildGarmentPieces
-    const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, wetStart, state.time, h,
+    const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, saturation, h,
                                            state.stepCount, poses, p, s.scratch[k]);
     ++gs.solves;
     gs.cgIterations += static_cast<uint64_t>(r.cgIterations);
@@ -106,40 +174,25 @@ size_t wetClothByContact(const Model& model, State& state, const NeighborLists& 
                          std::vector<uint8_t>& keep, double time) {
   // no cloth, or no piece wetted by contact (clothWetStart is then empty)
   if (model.numCloth == 0 || state.clothWetStart.size() != static_cast<size_t>(model.numCloth)) return 0;
-  Particles& p = state.particles;
+  const Particles& p = state.particles;
   const int64_t nc = model.numCloth;
   const float now = static_cast<float>(time);
-  auto wettable = [&](int64_t i) { return model.pieces[size_t(clothPiece(p.phase[i]))].wetByContact; };
   if (model.wetting.enabled) {  // Shao's absorption carries the water: wet once it holds some
     for (int64_t i = 0; i < nc; ++i)
-      if (wettable(i) && state.clothWater[size_t(i)] > 0.0 && !std::isfinite(state.clothWetStart[size_t(i)]))
+      if (model.pieces[size_t(clothPiece(p.phase[i]))].wetByContact && state.clothWater[size_t(i)] > 0.0 &&
+          !std::isfinite(state.clothWetStart[size_t(i)]))
         state.clothWetStart[size_t(i)] = now;
     return 0;
   }
   const int64_t n = static_cast<int64_t>(p.size());
   if (n == nc || nb.start.size() < static_cast<size_t>(n) + 1) return 0;
-  // each water particle finds the nearest wettable cloth vertex within touch distance (gather)
-  s.touch.assign(static_cast<size_t>(n), -1);
-  parallelFor(n - nc, [&](int64_t jj) {
-    const int64_t j = nc + jj;
-    float best = std::numeric_limits<float>::infinity();
-    int32_t hit = -1;
-    for (uint32_t e = nb.start[size_t(j)]; e < nb.start[size_t(j) + 1]; ++e) {
-      const int64_t i = nb.index[e];
-      if (i >= nc || !wettable(i)) continue;
-      const float d = (p.x[size_t(i)] - p.x[size_t(j)]).norm();
-      const float reach = touchDistance(model, model.pieces[size_t(clothPiece(p.phase[i]))]);
-      if (d < reach && d < best) {
-        best = d;
-        hit = static_cast<int32_t>(i);
-      }
-    }
-    s.touch[size_t(j)] = hit;
-  });
-  // a cloth vertex is wet when any water particle is within reach of it (the particle's footprint)
+  findTouches(model, state, nb, s.touch);
+  // unlimited supply (Chen as printed): a vertex is wet when any water particle is within reach of it
   parallelFor(nc, [&](int64_t i) {
-    if (!wettable(i) || std::isfinite(state.clothWetStart[size_t(i)])) return;
-    const float reach = touchDistance(model, model.pieces[size_t(clothPiece(p.phase[i]))]);
+    const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[i]))];
+    if (!piece.wetByContact || !piece.garment.saturation.unlimitedSupply || std::isfinite(state.clothWetStart[size_t(i)]))
+      return;
+    const float reach = touchDistance(model, piece);
     for (uint32_t e = nb.start[size_t(i)]; e < nb.start[size_t(i) + 1]; ++e) {
       const int64_t j = nb.index[e];
       if (j >= nc && s.touch[size_t(j)] >= 0 && (p.x[size_t(i)] - p.x[size_t(j)]).norm() < reach) {
@@ -148,19 +201,7 @@ size_t wetClothByContact(const Model& model, State& state, const NeighborLists& 
       }
     }
   });
-  // the particles that touched a piece with dropsVanish go, in particle order (deterministic)
-  keep.assign(static_cast<size_t>(n), 1);
-  size_t taken = 0;
-  for (int64_t j = nc; j < n; ++j) {
-    const int32_t i = s.touch[size_t(j)];
-    if (i < 0 || !model.pieces[size_t(clothPiece(p.phase[i]))].dropsVanish) continue;
-    keep[size_t(j)] = 0;
-    state.ledger.takenByCloth += p.mass[size_t(j)];
-    ++taken;
-  }
-  state.ledger.particlesTakenByCloth += taken;
-  if (taken) p.compact(keep);
-  return taken;
+  return takeTouchingWater(model, state, s.touch, now, keep);
 }
 
 }  // namespace soak

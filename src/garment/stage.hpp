@@ -1,7 +1,8 @@
 // the Chen 2012 garment stages of the step (docs/garment.md, "Calls from the step"): the implicit
 // solve of every piece with "solver": "implicit", the saturation mass of Eq. 15-19 for any piece
-// that asks for it, and the wet signal (the time each cloth vertex first got wet) that the
-// saturation mass, the wet friction of Fig. 5 and the wrinkle disturbances read.
+// that asks for it, and the water that reaches the cloth: each vertex's held water
+// (State::clothWater) and saturation (State::clothSaturation), which the saturation mass, the wet
+// friction of Fig. 5 and the wrinkle disturbances read.
 #pragma once
 #include <soak/model.hpp>
 #include <soak/state.hpp>
@@ -24,12 +25,14 @@ struct GarmentScratch {
   std::vector<ImplicitScratch> scratch;  // per cloth piece (used by the implicit ones)
   std::vector<Vec3> solved;              // xPred of the implicit cloth particles right after their solve
   std::vector<int32_t> touch;            // per particle: the cloth vertex a water particle wets, or -1
+  std::vector<float> fraction;           // a piece's S / S^MAX when Shao's wetting is on
 };
 
-// before the PBD stages, after predictPositions (which moves only water and PBD cloth): sets the Eq. 15-19 mass
-// of every piece with garment.saturationMass, then runs garmentSubstep (Eq. 1-5, wrinkles, contact
-// with wet friction) for every implicit piece, writing its xPred and v. poses are the colliders at
-// state.time + h.
+// before the PBD stages, after predictPositions (which moves only water and PBD cloth): advances the
+// saturation of the pieces with wetByContact to state.time + h (updateSaturation; with Shao's wetting
+// on its S / S^MAX is used instead), sets the Eq. 15-19 mass of every piece with
+// garment.saturationMass, then runs garmentSubstep (Eq. 1-5, wrinkles, contact with wet friction)
+// for every implicit piece, writing its xPred and v. poses are the colliders at state.time + h.
 void solveGarments(const Model& model, State& state, GarmentScratch& s, const std::vector<ColliderPose>& poses,
                    float h, StepStats& stats);
 
@@ -38,17 +41,20 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
 // wetting) is not moved by the water: the displacement is undone (one-way coupling)
 void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch& s, float h);
 
-// after commitPositions: records the first wet time of the vertices of pieces with wetByContact.
-// With Shao's wetting on, a vertex is wet once it holds water (State::clothWater > 0). Without it, a
-// vertex is wet when a water particle comes within touchDistance(piece) of it (a particle wets every
-// vertex within its reach); the particle then vanishes into the cloth when the piece of the nearest
-// vertex it touches has dropsVanish (counted in WaterLedger::takenByCloth).
+// after commitPositions: the water that reaches the pieces with wetByContact, and the first wet time
+// of their vertices. With Shao's wetting on, a vertex is wet once it holds water (State::clothWater >
+// 0) and nothing else happens here. Without it, a water particle within touchDistance(piece) of a
+// vertex that still takes water goes into the nearest such vertex's clothWater (which is then wet);
+// a vertex takes water until it holds delta m_dry, so the rain on a full vertex stays water and runs
+// off. A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
+// reaches, and the particle vanishes when the piece has dropsVanish (WaterLedger::takenByCloth).
 // time is the end of the substep. Returns the number of water particles taken.
 size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,
                          std::vector<uint8_t>& keep, double time);
 
-// per cloth particle, how wet it is in [0, 1]: Q(t) / delta (Eq. 18) for the pieces with wetByContact,
-// 0 elsewhere and for dry vertices (the "wetness" attribute of the cloth PLY)
+// per cloth particle, how wet it is in [0, 1]: the saturation s = Q / delta (Eq. 18) of the pieces
+// with wetByContact (S / S^MAX with Shao's wetting on), 0 elsewhere (the "wetness" attribute of the
+// cloth PLY)
 std::vector<float> clothWetness(const Model& model, const State& state);
 
 // the distance within which a water particle wets a cloth vertex: the piece's thickness (the

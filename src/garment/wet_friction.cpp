@@ -15,11 +15,11 @@ float smoothstep(float s) {
 
 }  // namespace
 
-float wetFriction(double wetTime, const WetFrictionParams& f) {
-  if (!(wetTime > 0.0) || !std::isfinite(wetTime)) return f.dry;
-  const double t = wetTime / static_cast<double>(f.timeScale);
-  if (t <= f.tau1) return f.dry + (f.peak - f.dry) * smoothstep(static_cast<float>(t / f.tau1));
-  if (t < f.tau2) return f.peak + (f.plateau - f.peak) * smoothstep(static_cast<float>((t - f.tau1) / (f.tau2 - f.tau1)));
+float wetFriction(float s, const WetFrictionParams& f) {
+  if (!(s > 0.0f) || !std::isfinite(s)) return f.dry;
+  const float s1 = f.peakSaturation, s2 = f.plateauSaturation;
+  if (s <= s1) return f.dry + (f.peak - f.dry) * smoothstep(s / s1);
+  if (s < s2) return f.peak + (f.plateau - f.peak) * smoothstep((s - s1) / (s2 - s1));
   return f.plateau;
 }
 

@@ -167,10 +167,16 @@ bool sideSprings(const SpringView& view, int a, int b, int best, std::vector<int
 
 }  // namespace
 
+float disturbanceStrength(const WrinkleParams& params, float saturation) {
+  const float s = std::clamp(std::isfinite(saturation) ? saturation : 0.0f, 0.0f, 1.0f);
+  return params.dryStrength + (params.strength - params.dryStrength) * s;  // wetter cloth wrinkles more (section 3.5)
+}
+
 std::vector<PositionConstraint> computeDisturbances(const Model& model, int piece, const SpringSet& springs,
                                                     const std::vector<std::vector<int>>& subdomains,
                                                     const Particles& p, const std::vector<ColliderPose>& poses,
-                                                    const WrinkleParams& params, uint64_t stepIndex) {
+                                                    const WrinkleParams& params, uint64_t stepIndex,
+                                                    std::span<const float> saturation) {
   std::vector<PositionConstraint> out;
   if (!params.enabled || params.interval < 1 || stepIndex % static_cast<uint64_t>(params.interval) != 0) return out;
   const SpringView view{model, springs, p, model.pieces[static_cast<size_t>(piece)].firstParticle, springs.kindStart[1]};
@@ -208,7 +214,9 @@ std::vector<PositionConstraint> computeDisturbances(const Model& model, int piec
     const Vec3& pa = view.pos(a);
     const int pick = chooseDisturbance(pa, hits, collides, view.pos(b), view.pos(d), params.tieTolerance * l0ab, coin);
     // an imperfection is small: a target further than one rest length from A is not used (departure 14)
-    if (pick >= 0 && (hits.point[pick] - pa).norm() <= l0ab) out.push_back({a, pa + params.strength * (hits.point[pick] - pa)});
+    if (pick < 0 || (hits.point[pick] - pa).norm() > l0ab) continue;
+    const float strength = disturbanceStrength(params, static_cast<size_t>(a) < saturation.size() ? saturation[a] : 1.0f);
+    if (strength > 0.0f) out.push_back({a, pa + strength * (hits.point[pick] - pa)});
   }
   return out;
 }

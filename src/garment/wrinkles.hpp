@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace soak {
@@ -48,13 +49,19 @@ float disturbanceCurvature(const Vec3& candidate, const Vec3& b, const Vec3& d);
 int chooseDisturbance(const Vec3& a, const SphereIntersection& hits, const std::array<bool, 2>& collides,
                       const Vec3& b, const Vec3& d, float tieDistance, int coin);
 
+// the fraction of the way to A' a vertex of this saturation (in [0, 1]) is moved: dryStrength for a
+// dry vertex, strength for a saturated one, linear between (the wetter the cloth, the deeper its wrinkles)
+float disturbanceStrength(const WrinkleParams& params, float saturation);
+
 // the disturbances of one cloth piece at this step: for each subdomain (sets of piece-local
 // vertices) near equilibrium whose most compressed stretch spring is below -compressionThreshold,
-// one constraint. Returns nothing unless params.enabled and stepIndex % interval == 0.
+// one constraint, moving A by disturbanceStrength of its saturation (piece-local; empty: all
+// saturated, so `strength` applies). Returns nothing unless params.enabled and stepIndex % interval == 0.
 std::vector<PositionConstraint> computeDisturbances(const Model& model, int piece, const SpringSet& springs,
                                                     const std::vector<std::vector<int>>& subdomains,
                                                     const Particles& p, const std::vector<ColliderPose>& poses,
-                                                    const WrinkleParams& params, uint64_t stepIndex);
+                                                    const WrinkleParams& params, uint64_t stepIndex,
+                                                    std::span<const float> saturation = {});
 
 // splits a mesh without panels into connected patches of about targetSize vertices: breadth-first
 // growth from the lowest unassigned vertex, then patches under half the size merged into their

@@ -229,7 +229,8 @@ void checkCheckpointFits(const std::string& path, const Checkpoint& c, const Mod
     if (!isWater(s.particles.phase[i])) fail(fmt::format("particle {} after the cloth is not water", i));
   if (s.emitters.size() != model.emitters.size())
     fail(fmt::format("{} emitters, the scene has {}", s.emitters.size(), model.emitters.size()));
-  const size_t wet = model.wetting.enabled ? nc : 0;
+  // Shao's wetting, or Chen's held water and saturation (a piece wetted by contact) use them
+  const size_t wet = model.wetting.enabled || !s.clothWetStart.empty() ? nc : 0;
   if (s.clothWater.size() != wet || s.clothBuffer.size() != wet || s.clothSaturation.size() != wet)
     fail(fmt::format("wetting arrays of {} entries, expected {}", s.clothWater.size(), wet));
   if (!s.clothWetStart.empty() && s.clothWetStart.size() != nc)

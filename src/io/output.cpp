@@ -42,7 +42,7 @@ std::vector<std::string> writeFrame(const std::string& dir, const Model& model, 
   std::vector<Vec3> colors = saturationColors(model, state, settings.colorRamp);
   std::vector<PlyFloatAttribute> extras;
   if (model.wetting.enabled) extras.push_back({"saturation", state.clothSaturation});
-  std::vector<float> wetness;  // Chen 2012 pieces without Shao's wetting: Q(t) / delta, same ramp
+  std::vector<float> wetness;  // Chen 2012 pieces without Shao's wetting: the saturation Q / delta, same ramp
   if (!model.wetting.enabled && !state.clothWetStart.empty()) {
     wetness = clothWetness(model, state);
     extras.push_back({"wetness", wetness});

@@ -79,13 +79,17 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.friction.dry = f.number("dry", d.friction.dry, Range::nonNegative());
   g.friction.peak = f.number("peak", d.friction.peak, Range::nonNegative());
   g.friction.plateau = f.number("plateau", d.friction.plateau, Range::nonNegative());
-  g.friction.tau1 = f.number("tau1", d.friction.tau1, Range::positive());
-  g.friction.tau2 = f.number("tau2", d.friction.tau2, Range::positive());
-  g.friction.timeScale = f.number("timeScale", d.friction.timeScale, Range::positive());
+  g.friction.peakSaturation = f.number("peakSaturation", d.friction.peakSaturation, Range{0.0, 1.0, true, true});
+  g.friction.plateauSaturation =
+      f.number("plateauSaturation", d.friction.plateauSaturation, Range{0.0, 1.0, true, false});
+  for (const char* key : {"tau1", "tau2", "timeScale"})  // the curve was over time since the first drop
+    if (f.has(key))
+      log.error(f.pathOf(key), "expected no times: the friction curve follows the saturation (give peakSaturation "
+                               "and plateauSaturation in (0, 1]; docs/scene-format.md)");
   f.finish();
-  if (!(g.friction.tau2 > g.friction.tau1))
-    log.error(f.pathOf("tau2"),
-              fmt::format("expected a time > friction.tau1 ({}), got {}", g.friction.tau1, g.friction.tau2));
+  if (!(g.friction.plateauSaturation > g.friction.peakSaturation))
+    log.error(f.pathOf("plateauSaturation"), fmt::format("expected a saturation > friction.peakSaturation ({}), got {}",
+                                                         g.friction.peakSaturation, g.friction.plateauSaturation));
   ObjectReader ray = r.object("rayleigh");
   if (const Json* a = ray.get("alpha"); a && a->is_number() && a->get<double>() < 0.0)
     log.error(ray.pathOf("alpha"), fmt::format("expected a number >= 0 (1/s; a negative alpha adds energy: the "
@@ -109,6 +113,10 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.wrinkles.patchSize = w.integer("patchSize", d.wrinkles.patchSize, Range::atLeast(3));
   g.wrinkles.tieTolerance = w.number("tieTolerance", d.wrinkles.tieTolerance, Range::nonNegative());
   g.wrinkles.strength = w.number("strength", d.wrinkles.strength, Range{0.0, 1.0, true, false});
+  g.wrinkles.dryStrength = w.number("dryStrength", d.wrinkles.dryStrength, Range::unit());
+  if (g.wrinkles.dryStrength > g.wrinkles.strength)
+    log.error(w.pathOf("dryStrength"), fmt::format("expected a fraction <= wrinkles.strength ({}), got {}",
+                                                   g.wrinkles.strength, g.wrinkles.dryStrength));
   g.wrinkles.seed = static_cast<uint32_t>(w.integer("seed", int(d.wrinkles.seed), Range::atLeast(0)));
   w.finish();
   r.finish();
@@ -250,7 +258,11 @@ ChenClothSpec readChenCloth(ObjectReader& r, ClothSolver solver, bool shaoWettin
   g.saturation.delta = s.number("delta", g.saturation.delta, Range::nonNegative());
   g.saturation.a3 = s.number("a3", g.saturation.a3, Range::positive());
   g.saturation.timeScale = s.number("timeScale", g.saturation.timeScale, Range::positive());
+  g.saturation.unlimitedSupply = s.choice("supply", {"drops", "unlimited"}, std::string("drops")) == 1;
   spec.dropsVanish = s.boolean("dropsVanish", true);
+  if (!g.saturation.unlimitedSupply && !spec.dropsVanish)
+    log.error(s.pathOf("dropsVanish"), "expected true, or saturation.supply \"unlimited\" (with the drops supply "
+                                       "the fabric takes the water particles that reach it)");
   spec.wetAtStart = s.boolean("wetAtStart", false);
   s.finish();
   if (enabled && shaoWetting)

@@ -457,6 +457,20 @@ void buildCloth(Model& model, const std::vector<ClothSpec>& cloth, const std::st
   buildGarmentPieces(model);  // Chen 2012 springs of the implicit pieces
 }
 
+// a Chen piece soaked at load: wet from t = 0; without Shao's wetting it holds delta m_dry at
+// saturation 1 (counted as emitted water, so the ledger closes) unless its supply is unlimited
+void wetPieceAtStart(const Model& model, int k, State& state) {
+  const ClothPiece& piece = model.pieces[size_t(k)];
+  const size_t first = size_t(piece.firstParticle), n = size_t(piece.particleCount);
+  std::fill_n(state.clothWetStart.begin() + first, n, 0.0f);
+  if (model.wetting.enabled || piece.garment.saturation.unlimitedSupply) return;
+  for (size_t i = first; i < first + n; ++i) {
+    state.clothWater[i] = waterCapacity(model.clothDryMass[i], piece.garment.saturation);
+    state.clothSaturation[i] = 1.0f;
+    state.ledger.emitted += state.clothWater[i];
+  }
+}
+
 // the initial state: the cloth particles at rest (pinned ones immovable), the emitters' states, the
 // wet-by-contact start times (0 for a piece wet from the start) and the wetting state
 void initState(ErrorLog& log, const Model& model, const std::vector<ClothSpec>& cloth, State& state) {
@@ -473,9 +487,13 @@ void initState(ErrorLog& log, const Model& model, const std::vector<ClothSpec>& 
   state.emitters.resize(model.emitters.size());
   for (const ClothPiece& piece : model.pieces)
     if (piece.wetByContact) state.clothWetStart.assign(size_t(model.numCloth), std::numeric_limits<float>::infinity());
+  if (!state.clothWetStart.empty() && !model.wetting.enabled) {  // Chen's saturation: water held, s per vertex
+    state.clothWater.assign(size_t(model.numCloth), 0.0);
+    state.clothBuffer.assign(size_t(model.numCloth), 0.0);
+    state.clothSaturation.assign(size_t(model.numCloth), 0.0f);
+  }
   for (size_t k = 0; k < cloth.size(); ++k)
-    if (cloth[k].chen.wetAtStart && model.pieces[k].wetByContact)
-      std::fill_n(state.clothWetStart.begin() + model.pieces[k].firstParticle, model.pieces[k].particleCount, 0.0f);
+    if (cloth[k].chen.wetAtStart && model.pieces[k].wetByContact) wetPieceAtStart(model, static_cast<int>(k), state);
   if (model.wetting.enabled) {
     const std::vector<float> volume = restVolumes(model, p.radius);
     checkDripThreshold(log, model, volume);

@@ -39,10 +39,10 @@ void makeHangingRig(Rig& r, int res, float size, float y, std::vector<int> pins)
 }
 
 ImplicitStats stepRig(Rig& r, double t, float h, const std::vector<PositionConstraint>& constraints = {},
-                      const std::vector<float>& wetStart = {}) {
+                      const std::vector<float>& saturation = {}) {
   r.poses.resize(r.model.colliders.size());
   for (size_t c = 0; c < r.model.colliders.size(); ++c) r.poses[c] = colliderPose(r.model.colliders[c], t + h);
-  const ImplicitStats s = implicitStep(r.model, r.g, r.params, t, h, r.poses, wetStart, constraints, r.p, r.scratch);
+  const ImplicitStats s = implicitStep(r.model, r.g, r.params, h, r.poses, saturation, constraints, r.p, r.scratch);
   r.p.x = r.p.xPred;  // the caller's commit
   return s;
 }
@@ -159,7 +159,10 @@ TEST(GarmentImplicit, RefusesNegativeRayleighAlphaAndBadLaws) {
   p.laws.stretch.a2 = -1.0f;
   EXPECT_THROW(checkGarmentParams(p, "g"), Error);
   p = GarmentParams{};
-  p.friction.tau2 = p.friction.tau1;
+  p.friction.plateauSaturation = p.friction.peakSaturation;
+  EXPECT_THROW(checkGarmentParams(p, "g"), Error);
+  p = GarmentParams{};
+  p.wrinkles.dryStrength = p.wrinkles.strength + 0.1f;
   EXPECT_THROW(checkGarmentParams(p, "g"), Error);
 }
 
@@ -168,7 +171,7 @@ TEST(GarmentImplicit, RefusesNegativeRayleighAlphaAndBadLaws) {
 TEST(GarmentImplicit, WetFrictionHoldsClothThatSlidesWhenDry) {
   auto slide = [](bool wet) {
     Rig r;
-    r.params.friction = WetFrictionParams{0.1f, 0.8f, 0.5f, 1.0f, 2.0f, 1.0f};
+    r.params.friction = WetFrictionParams{0.1f, 0.8f, 0.5f, 0.2f, 0.5f};
     const Quat tilt(Eigen::AngleAxisf(20.0f * kPi / 180.0f, Vec3::UnitZ()));
     Collider plane;
     plane.shape = ColliderShape::Plane;
@@ -181,10 +184,10 @@ TEST(GarmentImplicit, WetFrictionHoldsClothThatSlidesWhenDry) {
     for (int i = 0; i < r.model.numCloth; ++i)
       r.p.add(1, uint32_t(i), r.model.clothDryMass[i], 0.04f, r.model.clothRestPosition[i], Vec3::Zero());
     r.g = buildGarmentPiece(r.model, 0, r.params);
-    const std::vector<float> wetStart(r.model.numCloth, wet ? -100.0f : kNeverWet);
+    const std::vector<float> saturation(r.model.numCloth, wet ? 1.0f : 0.0f);
     const float h = 1.0f / 60.0f;
     int contacts = 0;
-    for (int k = 0; k < 60; ++k) contacts = stepRig(r, k * h, h, {}, wetStart).contacts;
+    for (int k = 0; k < 60; ++k) contacts = stepRig(r, k * h, h, {}, saturation).contacts;
     EXPECT_GT(contacts, r.model.numCloth / 2);
     Vec3 c = Vec3::Zero();
     for (int i = 0; i < r.model.numCloth; ++i) {
@@ -241,11 +244,11 @@ TEST(GarmentImplicit, SaturatedClothHangsLowerThanDry) {
     Rig r;
     r.params.saturation = saturationPreset("high_absorption");
     makeHangingRig(r, 10, 0.5f, 1.0f, {0, 9});
-    const std::vector<float> wetStart(r.model.numCloth, wet ? -100.0f : kNeverWet);
+    const std::vector<float> saturation(r.model.numCloth, wet ? 1.0f : 0.0f);
     const float h = 1.0f / 60.0f;
     for (int k = 0; k < 180; ++k) {
       r.poses.clear();
-      const ImplicitStats s = garmentSubstep(r.model, r.g, r.params, wetStart, k * h, h, uint64_t(k), r.poses, r.p,
+      const ImplicitStats s = garmentSubstep(r.model, r.g, r.params, saturation, h, uint64_t(k), r.poses, r.p,
                                              r.scratch);
       EXPECT_TRUE(s.converged);
       r.p.x = r.p.xPred;

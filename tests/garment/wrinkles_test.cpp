@@ -131,6 +131,37 @@ TEST(GarmentWrinkles, CompressedSheetGetsOutOfPlaneTargetsAtRestLength) {
   for (size_t k = 0; k < c.size(); ++k) EXPECT_EQ(again[k].target, c[k].target);
 }
 
+// the disturbance follows the water: a vertex of saturation s moves dryStrength + (strength -
+// dryStrength) s of the way to A'; a dry sheet with dryStrength 0 gets no disturbance at all, a half
+// saturated one the same vertices as a saturated one, half as far
+TEST(GarmentWrinkles, DisturbancesGrowWithTheSaturation) {
+  WrinkleParams wp;
+  wp.enabled = true;
+  wp.strength = 0.8f;
+  wp.dryStrength = 0.2f;
+  EXPECT_FLOAT_EQ(disturbanceStrength(wp, 0.0f), 0.2f);
+  EXPECT_FLOAT_EQ(disturbanceStrength(wp, 0.5f), 0.5f);
+  EXPECT_FLOAT_EQ(disturbanceStrength(wp, 1.0f), 0.8f);
+  EXPECT_FLOAT_EQ(disturbanceStrength(wp, 2.0f), 0.8f);
+  EXPECT_FLOAT_EQ(disturbanceStrength(wp, NAN), 0.2f);
+  Sheet s;
+  makeSqueezedSheet(s);
+  wp.strength = 1.0f;
+  wp.dryStrength = 0.0f;
+  const std::vector<float> dry(size_t(s.model.numCloth), 0.0f), half(size_t(s.model.numCloth), 0.5f);
+  EXPECT_TRUE(computeDisturbances(s.model, 0, s.springs, s.patches, s.p, {}, wp, 0, dry).empty());
+  const std::vector<PositionConstraint> full = computeDisturbances(s.model, 0, s.springs, s.patches, s.p, {}, wp, 0);
+  const std::vector<PositionConstraint> halfway =
+      computeDisturbances(s.model, 0, s.springs, s.patches, s.p, {}, wp, 0, half);
+  ASSERT_FALSE(full.empty());
+  ASSERT_EQ(halfway.size(), full.size());
+  for (size_t k = 0; k < full.size(); ++k) {
+    ASSERT_EQ(halfway[k].vertex, full[k].vertex);
+    const Vec3& a = s.p.x[size_t(full[k].vertex)];
+    EXPECT_LT((halfway[k].target - (a + 0.5f * (full[k].target - a))).norm(), 1e-6f) << k;
+  }
+}
+
 TEST(GarmentWrinkles, ColliderBelowSendsEveryBuckleUp) {
   Sheet s;
   Collider floor;

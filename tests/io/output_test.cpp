@@ -102,22 +102,24 @@ TEST(IoOutput, WriteFrameCarriesSaturationAndItsColours) {
   fs::remove_all(dir);
 }
 
-// a Chen 2012 piece without Shao's wetting: the PLY carries "wetness" = Q(t - t_wet) / delta and the OBJ
-// colours follow it on the ramp with 1 drawn black
+// a Chen 2012 piece without Shao's wetting: the PLY carries "wetness", each vertex's saturation
+// Q / delta, and the OBJ colours follow it on the ramp with 1 drawn black
 TEST(IoOutput, WriteFrameCarriesTheWetnessOfAChenPiece) {
   Fixture f = makeFixture();
-  f.model.pieces[0].wetByContact = true;  // cotton: delta 0.84, a3 8.844 s
-  f.state.time = 4.0;
+  f.model.pieces[0].wetByContact = true;
   f.state.clothWetStart.assign(13, std::numeric_limits<float>::infinity());
-  f.state.clothWetStart[2] = 0.0f;
-  f.state.clothWetStart[10] = 1.0f;  // in the patch, which is not wetted by contact
+  f.state.clothWater.assign(13, 0.0);
+  f.state.clothBuffer.assign(13, 0.0);
+  f.state.clothSaturation.assign(13, 0.0f);
+  const double q = 0.3636;
+  f.state.clothSaturation[2] = float(q);
+  f.state.clothSaturation[10] = 0.5f;  // in the patch, which is not wetted by contact
   const fs::path dir = tempDir("wetness");
   writeFrame(dir.string(), f.model, f.state, OutputSettings{}, 0);
   const PlyData ply = readPly((dir / "cloth_0000.ply").string());
   const PlyElement& v = ply.element("vertex");
   ASSERT_TRUE(v.has("wetness"));
   EXPECT_FALSE(v.has("saturation"));
-  const double q = 1.0 - std::exp(-4.0 / 8.844);
   EXPECT_NEAR(v.scalar("wetness")[2], q, 1e-6);
   EXPECT_EQ(v.scalar("wetness")[3], 0.0);
   EXPECT_EQ(v.scalar("wetness")[10], 0.0);

@@ -31,7 +31,8 @@ TEST(GarmentScene, KeysReachTheModel) {
                "mesh": {"type": "garment", "body": "body", "edgeLength": 0.04},
                "saturation": {"timeScale": 60},
                "garment": {"shear": {"a1": 50, "a2": 1}, "rayleigh": {"beta": 0.002},
-                           "friction": {"peak": 0.7, "tau1": 1, "tau2": 3}, "wrinkles": {"interval": 5}}}],
+                           "friction": {"peak": 0.7, "peakSaturation": 0.1, "plateauSaturation": 0.3},
+                           "wrinkles": {"interval": 5}}}],
     "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [0.5, 0.3], "rate": 100}]})");
   const Model& m = s.model;
   ASSERT_EQ(m.colliders.size(), 18u);
@@ -112,8 +113,14 @@ TEST(GarmentSceneErrors, KeysOfTheOtherSolverAreRefused) {
   EXPECT_HAS(loadError(kSheet, {"cloth.0.solver=verlet"}), "at cloth[0].solver: expected one of \"pbd\", \"implicit\"");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.rayleigh.alpha=-9"}),
              "at cloth[0].garment.rayleigh.alpha: expected a number >= 0 (1/s; a negative alpha adds energy");
-  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.friction.tau2=1"}),
-             "at cloth[0].garment.friction.tau2: expected a time > friction.tau1 (2), got 1");
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.friction.plateauSaturation=0.1"}),
+             "at cloth[0].garment.friction.plateauSaturation: expected a saturation > friction.peakSaturation (0.2), "
+             "got 0.1");
+  // the curve was over time once: the old keys are refused with what to give instead
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.friction.tau1=2"}),
+             "at cloth[0].garment.friction.tau1: expected no times: the friction curve follows the saturation");
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.friction.peakSaturation=1"}),
+             "at cloth[0].garment.friction.peakSaturation: expected a number in");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.stretch.a1=0"}), "at cloth[0].garment.stretch.a1: expected a number > 0");
 }
 
@@ -212,10 +219,10 @@ TEST(ChenKeys, RainKeysReachTheEmitterAndEndMustFollowStart) {
 TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   const Scene s = fromString(kSheet, {R"(cloth.0.garment={"stretch": {"a1": 700, "a2": 2}, "shear": {"a1": 60, "a2": 0.5},
       "bend": {"a1": 3, "a2": 1}, "strainLimit": 0.7, "bendStraightness": 0.6,
-      "friction": {"dry": 0.2, "peak": 0.9, "plateau": 0.4, "tau1": 1.5, "tau2": 4, "timeScale": 2},
+      "friction": {"dry": 0.2, "peak": 0.9, "plateau": 0.4, "peakSaturation": 0.15, "plateauSaturation": 0.8},
       "rayleigh": {"alpha": 0.5, "beta": 0.001}, "cg": {"tolerance": 1e-6, "maxIterations": 77},
       "wrinkles": {"compressionThreshold": 0.1, "equilibriumSpeed": 0.3, "interval": 4, "patchSize": 50,
-                   "tieTolerance": 0.01, "strength": 0.5, "seed": 9}})"});
+                   "tieTolerance": 0.01, "strength": 0.5, "dryStrength": 0.25, "seed": 9}})"});
   const GarmentParams& g = s.model.pieces[0].garment;
   EXPECT_FLOAT_EQ(g.laws.stretch.a1, 700.0f);
   EXPECT_FLOAT_EQ(g.laws.stretch.a2, 2.0f);
@@ -226,9 +233,8 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_FLOAT_EQ(g.friction.dry, 0.2f);
   EXPECT_FLOAT_EQ(g.friction.peak, 0.9f);
   EXPECT_FLOAT_EQ(g.friction.plateau, 0.4f);
-  EXPECT_FLOAT_EQ(g.friction.tau1, 1.5f);
-  EXPECT_FLOAT_EQ(g.friction.tau2, 4.0f);
-  EXPECT_FLOAT_EQ(g.friction.timeScale, 2.0f);
+  EXPECT_FLOAT_EQ(g.friction.peakSaturation, 0.15f);
+  EXPECT_FLOAT_EQ(g.friction.plateauSaturation, 0.8f);
   EXPECT_FLOAT_EQ(g.rayleighAlpha, 0.5f);
   EXPECT_FLOAT_EQ(g.rayleighBeta, 0.001f);
   EXPECT_FLOAT_EQ(g.cgTolerance, 1e-6f);
@@ -240,6 +246,7 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_EQ(g.wrinkles.patchSize, 50);
   EXPECT_FLOAT_EQ(g.wrinkles.tieTolerance, 0.01f);
   EXPECT_FLOAT_EQ(g.wrinkles.strength, 0.5f);
+  EXPECT_FLOAT_EQ(g.wrinkles.dryStrength, 0.25f);
   EXPECT_EQ(g.wrinkles.seed, 9u);
   // absent sections keep the defaults; wrinkles stay off unless their section is there
   const GarmentParams& d = fromString(kSheet, {"cloth.0.garment={}"}).model.pieces[0].garment;
@@ -252,21 +259,42 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
              "at cloth[0].garment.wrinkles.patchSize: expected an integer >= 3, got 2");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.strainLimit=1.5"}), "at cloth[0].garment.strainLimit: expected a number in");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.stretch.a3=1"}), "at cloth[0].garment.stretch.a3: unknown key 'a3'");
+  EXPECT_HAS(loadError(kSheet, {R"(cloth.0.garment.wrinkles={"strength": 0.2, "dryStrength": 0.3})"}),
+             "at cloth[0].garment.wrinkles.dryStrength: expected a fraction <= wrinkles.strength (0.2), got 0.3");
 }
 
-// the fabric sets delta and a3 (Table 1), explicit saturation keys override them; wetAtStart wets every
-// vertex from t = 0; dropsVanish has no meaning, and is refused, with Shao's wetting on
+// the fabric sets delta and a3 (Table 1), explicit saturation keys override them; the supply is the
+// drops unless "unlimited"; wetAtStart wets every vertex from t = 0 (with the drops supply: full, its
+// water counted as emitted); dropsVanish false needs the unlimited supply, and has no meaning, and is
+// refused, with Shao's wetting on
 TEST(ChenKeys, SaturationKeysOverrideTheFabricAndWetAtStart) {
   const Scene s = fromString(kSheet, {"cloth.0.fabric=cotton", "cloth.0.saturation.delta=2",
-                                      "cloth.0.saturation.wetAtStart=true", "cloth.0.saturation.dropsVanish=false"});
+                                      "cloth.0.saturation.wetAtStart=true", "cloth.0.saturation.supply=\"unlimited\"",
+                                      "cloth.0.saturation.dropsVanish=false"});
   const ClothPiece& p = s.model.pieces[0];
   EXPECT_FLOAT_EQ(p.garment.saturation.delta, 2.0f);
   EXPECT_FLOAT_EQ(p.garment.saturation.a3, 8.844f);  // cotton's
+  EXPECT_TRUE(p.garment.saturation.unlimitedSupply);
   EXPECT_FALSE(p.dropsVanish);
   ASSERT_EQ(s.state.clothWetStart.size(), size_t(s.model.numCloth));
   for (float t : s.state.clothWetStart) EXPECT_EQ(t, 0.0f);
+  EXPECT_EQ(s.state.ledger.emitted, 0.0) << "an unlimited supply holds no counted water";
+  const Scene soaked = fromString(kSheet, {"cloth.0.saturation.wetAtStart=true"});
+  EXPECT_FALSE(soaked.model.pieces[0].garment.saturation.unlimitedSupply);
+  double held = 0.0;
+  for (int i = 0; i < soaked.model.numCloth; ++i) {
+    EXPECT_NEAR(soaked.state.clothWater[size_t(i)], 1.24 * double(soaked.model.clothDryMass[size_t(i)]), 1e-10);
+    EXPECT_EQ(soaked.state.clothSaturation[size_t(i)], 1.0f);
+    held += soaked.state.clothWater[size_t(i)];
+  }
+  EXPECT_DOUBLE_EQ(soaked.state.ledger.emitted, held);
   const Scene dry = fromString(kSheet);
   for (float t : dry.state.clothWetStart) EXPECT_EQ(t, std::numeric_limits<float>::infinity());
+  EXPECT_EQ(dry.state.clothWater, std::vector<double>(size_t(dry.model.numCloth), 0.0));
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.saturation.dropsVanish=false"}),
+             "at cloth[0].saturation.dropsVanish: expected true, or saturation.supply \"unlimited\"");
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.saturation.supply=\"rain\""}),
+             "at cloth[0].saturation.supply: expected one of \"drops\", \"unlimited\"");
   EXPECT_HAS(loadError(kSheet, {"wetting.enabled=true", "wetting.emission.massThreshold=1e-5",
                                 "cloth.0.saturation.dropsVanish=true"}),
              "garment.json: at cloth[0].saturation.dropsVanish: expected no dropsVanish while the wetting section is on");
