@@ -58,26 +58,58 @@ void findTouches(const Model& model, const State& state, const NeighborLists& nb
   });
 }
 
-// the touching particles go, in particle order (deterministic): into the vertex's water (held,
-// until it holds delta m_dry; a drop reaching a full vertex stays and runs off), or with an unlimited
+// soaks a drop of m kg into the fabric around vertex i (drops supply): the vertices of the piece
+// with room, breadth first over the mesh from i, each filled up to delta m_dry, until the drop is
+// in (a drop heavier than one vertex holds spreads over the spot it wets). False, with nothing
+// changed, when the nearest kMaxSoakVertices vertices have no room for all of it.
+bool soakDrop(const Model& model, State& state, int32_t i, double m, float now, GarmentScratch& s) {
+  constexpr size_t kMaxSoakVertices = 256;
+  const SaturationParams& sat = model.pieces[size_t(clothPiece(state.particles.phase[i]))].garment.saturation;
+  s.soakOrder.assign(1, i);
+  s.soakSeen.resize(static_cast<size_t>(model.numCloth), 0);
+  s.soakSeen[size_t(i)] = 1;
+  double room = 0.0;
+  for (size_t k = 0; k < s.soakOrder.size() && room < m && k < kMaxSoakVertices; ++k) {
+    const int v = s.soakOrder[k];
+    room += std::max(0.0, waterCapacity(model.clothDryMass[size_t(v)], sat) - state.clothWater[size_t(v)]);
+    for (int e = model.vertexNeighborStart[size_t(v)]; e < model.vertexNeighborStart[size_t(v) + 1]; ++e) {
+      const int w = model.vertexNeighbors[size_t(e)];
+      if (!s.soakSeen[size_t(w)]) {
+        s.soakSeen[size_t(w)] = 1;
+        s.soakOrder.push_back(w);
+      }
+    }
+  }
+  for (int v : s.soakOrder) s.soakSeen[size_t(v)] = 0;
+  if (room < m) return false;
+  for (size_t k = 0; k < s.soakOrder.size() && m > 0.0; ++k) {
+    const size_t v = static_cast<size_t>(s.soakOrder[k]);
+    const double put = std::min(m, std::max(0.0, waterCapacity(model.clothDryMass[v], sat) - state.clothWater[v]));
+    if (!(put > 0.0)) continue;
+    state.clothWater[v] += put;
+    m -= put;
+    if (!std::isfinite(state.clothWetStart[v])) state.clothWetStart[v] = now;
+  }
+  return true;
+}
+
+// the touching particles go, in particle order (deterministic): into the fabric around the vertex
+// (soakDrop; a drop the fabric there has no room for stays and runs off), or with an unlimited
 // supply and dropsVanish out of the simulation (counted in WaterLedger::takenByCloth)
-size_t takeTouchingWater(const Model& model, State& state, const std::vector<int32_t>& touch, float now,
-                         std::vector<uint8_t>& keep) {
+size_t takeTouchingWater(const Model& model, State& state, GarmentScratch& s, float now, std::vector<uint8_t>& keep) {
   Particles& p = state.particles;
   const int64_t n = static_cast<int64_t>(p.size());
   keep.assign(static_cast<size_t>(n), 1);
   size_t taken = 0;
   for (int64_t j = model.numCloth; j < n; ++j) {
-    const int32_t i = touch[size_t(j)];
+    const int32_t i = s.touch[size_t(j)];
     if (i < 0) continue;
     const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[i]))];
     if (piece.garment.saturation.unlimitedSupply) {
       if (!piece.dropsVanish) continue;
       state.ledger.takenByCloth += p.mass[size_t(j)];
-    } else {
-      if (!takesWater(model, state, piece, i)) continue;  // filled by an earlier drop of this substep
-      state.clothWater[size_t(i)] += p.mass[size_t(j)];
-      if (!std::isfinite(state.clothWetStart[size_t(i)])) state.clothWetStart[size_t(i)] = now;
+    } else if (!soakDrop(model, state, i, p.mass[size_t(j)], now, s)) {
+      continue;
     }
     keep[size_t(j)] = 0;
     ++taken;
@@ -201,7 +233,7 @@ size_t wetClothByContact(const Model& model, State& state, const NeighborLists& 
       }
     }
   });
-  return takeTouchingWater(model, state, s.touch, now, keep);
+  return takeTouchingWater(model, state, s, now, keep);
 }
 
 }  // namespace soak

@@ -26,6 +26,8 @@ struct GarmentScratch {
   std::vector<Vec3> solved;              // xPred of the implicit cloth particles right after their solve
   std::vector<int32_t> touch;            // per particle: the cloth vertex a water particle wets, or -1
   std::vector<float> fraction;           // a piece's S / S^MAX when Shao's wetting is on
+  std::vector<int> soakOrder;            // the vertices a drop soaks into, nearest first
+  std::vector<uint8_t> soakSeen;         // per cloth particle, during one drop's soak
 };
 
 // before the PBD stages, after predictPositions (which moves only water and PBD cloth): advances the
@@ -44,9 +46,9 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
 // after commitPositions: the water that reaches the pieces with wetByContact, and the first wet time
 // of their vertices. With Shao's wetting on, a vertex is wet once it holds water (State::clothWater >
 // 0) and nothing else happens here. Without it, a water particle within touchDistance(piece) of a
-// vertex that still takes water goes into the nearest such vertex's clothWater (which is then wet);
-// a vertex takes water until it holds delta m_dry, so the rain on a full vertex stays water and runs
-// off. A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
+// vertex that still takes water soaks into the fabric from the nearest such vertex: into its
+// clothWater up to delta m_dry, the rest into its mesh neighbours with room, nearest rings first
+// (every vertex that gets water is wet). Rain on fabric with no room for it stays water and runs off. A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
 // reaches, and the particle vanishes when the piece has dropsVanish (WaterLedger::takenByCloth).
 // time is the end of the substep. Returns the number of water particles taken.
 size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,
