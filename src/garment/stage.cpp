@@ -2,6 +2,7 @@
 #include "garment/stage.hpp"
 
 #include "core/parallel.hpp"
+#include "world/garment_mesh.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -148,6 +149,27 @@ std::vector<float> clothWetness(const Model& model, const State& state) {
     std::copy(s.begin(), s.end(), wet.begin() + piece.firstParticle);
   }
   return wet;
+}
+
+GarmentShape garmentShape(const Model& model, const State& state) {
+  GarmentShape g;
+  const std::vector<float> wet = clothWetness(model, state);
+  double lowest = std::numeric_limits<double>::infinity(), distance = 0.0, saturation = 0.0;
+  for (const ClothPiece& piece : model.pieces) {
+    if (piece.solver != ClothSolver::Implicit && !piece.wetByContact) continue;
+    for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
+      const Vec3& x = state.particles.x[size_t(i)];
+      lowest = std::min(lowest, double(x.y()));
+      if (!model.colliders.empty()) distance += bodyDistance(model.colliders, state.time, x, nullptr);
+      saturation += wet[size_t(i)];
+      ++g.vertices;
+    }
+  }
+  if (g.vertices == 0) return g;
+  g.lowest = lowest;
+  g.meanColliderDistance = distance / g.vertices;
+  g.meanSaturation = saturation / g.vertices;
+  return g;
 }
 
 float touchDistance(const Model& model, const ClothPiece& piece) {

@@ -1,5 +1,6 @@
 #include "io/stats.hpp"
 
+#include "garment/stage.hpp"
 #include "io/file.hpp"
 
 #include <algorithm>
@@ -90,6 +91,12 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},
                     {"wetVertices", wet}};
+    const GarmentShape shape = garmentShape(model, state);  // how it hangs: wet against dry
+    if (shape.vertices > 0) {
+      j["garment"]["lowestPoint"] = shape.lowest;
+      j["garment"]["meanSaturation"] = shape.meanSaturation;
+      if (!model.colliders.empty()) j["garment"]["meanColliderDistance"] = shape.meanColliderDistance;
+    }
   }
   j["removedAtBounds"] = {{"frame", fs.removedParticles}, {"total", state.ledger.particlesRemovedAtBounds}};
   j["emittedParticles"] = fs.emittedParticles;

@@ -180,5 +180,35 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   EXPECT_EQ(j["garment"]["wetVertices"], 2);
 }
 
+// how a Chen piece hangs, at the frame's end: its lowest vertex, its mean saturation and its mean
+// distance to the nearest collider (absent without colliders); the other piece does not count
+TEST(IoStats, GarmentShapeOfTheWettedPieces) {
+  Fixture f = makeFixture();
+  f.model.pieces[0].wetByContact = true;  // "sheet": 9 vertices; "patch" is not a garment
+  f.state.clothWetStart.assign(13, std::numeric_limits<float>::infinity());
+  f.state.clothWater.assign(13, 0.0);
+  f.state.clothBuffer.assign(13, 0.0);
+  f.state.clothSaturation.assign(13, 0.0f);
+  f.state.clothSaturation[2] = 0.9f;
+  f.state.clothSaturation[11] = 1.0f;  // the patch's
+  Particles& p = f.state.particles;
+  p.x[4].y() -= 0.25f;
+  double lowest = 1e30;
+  for (int i = 0; i < 9; ++i) lowest = std::min(lowest, double(p.x[size_t(i)].y()));
+  auto j = frameStatsJson(f.model, f.state, 0, FrameStats{});
+  EXPECT_DOUBLE_EQ(j["garment"]["lowestPoint"].get<double>(), lowest);
+  EXPECT_NEAR(j["garment"]["meanSaturation"].get<double>(), 0.1, 1e-7);
+  EXPECT_FALSE(j["garment"].contains("meanColliderDistance"));
+  Collider ball;
+  ball.shape = ColliderShape::Sphere;
+  ball.radius = 0.1f;
+  ball.keys = {Keyframe{0.0f, Vec3(0.0f, -1.0f, 0.0f), Quat::Identity()}};
+  f.model.colliders.push_back(ball);
+  double mean = 0.0;
+  for (int i = 0; i < 9; ++i) mean += (p.x[size_t(i)] - Vec3(0.0f, -1.0f, 0.0f)).norm() - 0.1;
+  j = frameStatsJson(f.model, f.state, 0, FrameStats{});
+  EXPECT_NEAR(j["garment"]["meanColliderDistance"].get<double>(), mean / 9.0, 1e-5);
+}
+
 }  // namespace
 }  // namespace soak
