@@ -74,8 +74,6 @@ struct GarmentParams {
   float cgTolerance = 1e-4f;          // relative preconditioned residual
   int cgMaxIterations = 300;
   bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
-  float adhesionStress = 4.0f;        // Pa: the pull of the skin's water film on saturated fabric (scaled by s)
-  float adhesionRange = -1.0f;        // m beyond the contact margin it reaches; < 0: the piece's thickness
 };
 
 }  // namespace soak

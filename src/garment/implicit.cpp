@@ -60,7 +60,6 @@ void checkGarmentParams(const GarmentParams& p, const std::string& where) {
   require(p.wrinkles.dryStrength >= 0.0f && p.wrinkles.dryStrength <= p.wrinkles.strength, where,
           "wrinkles.dryStrength", fmt::format("a number in [0, wrinkles.strength ({})]", p.wrinkles.strength),
           p.wrinkles.dryStrength);
-  require(p.adhesionStress >= 0.0f, where, "adhesion.stress", "a number >= 0 (Pa)", p.adhesionStress);
   require(p.wrinkles.patchSize >= 3, where, "wrinkles.patchSize", "an integer >= 3", p.wrinkles.patchSize);
 }
 
@@ -132,34 +131,6 @@ void constrainRows(const Model& model, const GarmentPiece& g, const std::vector<
   for (uint8_t c : w.constrained) stats.constrainedVertices += c ? 1 : 0;
 }
 
-// wet adhesion (departure 16): each vertex with saturation s > 0 within adhesionRange of a collider's
-// contact margin at the start of the step is pulled towards the nearest such collider by
-// adhesionStress s A (A its rest area), an external force of the solve like gravity
-void adhesionForces(const Model& model, const GarmentPiece& g, const GarmentParams& params,
-                    const std::vector<ColliderPose>& poses, std::span<const float> saturation, const Particles& p,
-                    ImplicitScratch& w) {
-  const size_t first = static_cast<size_t>(g.firstParticle);
-  const size_t numColliders = std::min(model.colliders.size(), poses.size());
-  w.adhesion.assign(static_cast<size_t>(g.count), Vec3d::Zero());
-  if (!(params.adhesionStress > 0.0f) || numColliders == 0 || saturation.empty()) return;
-  const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
-  const float range = params.adhesionRange >= 0.0f ? params.adhesionRange
-                                                    : model.pieces[static_cast<size_t>(g.piece)].material.thickness;
-  parallelFor(g.count, [&](int64_t v) {
-    const float s = static_cast<size_t>(v) < saturation.size() ? std::min(saturation[v], 1.0f) : 0.0f;
-    if (!(s > 0.0f)) return;
-    const size_t i = first + static_cast<size_t>(v);
-    float gap = range;
-    Vec3 toward = Vec3::Zero();
-    for (size_t c = 0; c < numColliders; ++c) {
-      Vec3 nrm;
-      const float d = colliderDistance(model.colliders[c], poses[c], p.x[i], &nrm) - margin;
-      if (d < gap) gap = d, toward = -nrm;
-    }
-    w.adhesion[v] = (double(params.adhesionStress) * s * model.clothRestArea[i]) * toward.cast<double>();
-  });
-}
-
 // A = M (1 + h alpha) + (h beta + h^2) K, b = h (f0 + h df/dx v0), gathered per row (Eq. 3-4)
 void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentParams& params, const Particles& p,
                     double hd, ImplicitScratch& w) {
@@ -177,7 +148,7 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
     const size_t i = first + static_cast<size_t>(v);
     const double m = p.mass[i];
     const Vec3d v0 = p.v[i].cast<double>();
-    Vec3d f = m * gravity - alpha * m * v0 + w.adhesion[v];  // gravity, the mass part of the damping (Eq. 24), adhesion
+    Vec3d f = m * gravity - alpha * m * v0;  // gravity and the mass part of the damping (Eq. 24)
     Eigen::Matrix3d kDiag = Eigen::Matrix3d::Zero();
     Vec3d kv = Vec3d::Zero();  // (K v0)_v
     int slot = g.rowStart[v] + 1;
@@ -303,7 +274,6 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   const double hd = h;
   springForces(g, params, p, w, stats);
   constrainRows(model, g, constraints, p, hd, w, stats);
-  adhesionForces(model, g, params, poses, saturation, p, w);
   assembleSystem(model, g, params, p, hd, w);
   CgOptions opt;
   opt.tolerance = params.cgTolerance;

@@ -59,7 +59,6 @@ struct ImplicitScratch {
   std::vector<float> strain;
   std::vector<Vec3d> rhs, dv;
   std::vector<uint8_t> constrained;
-  std::vector<Vec3d> adhesion;     // N, the wet adhesion force on each vertex (adhesionForces)
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
 };

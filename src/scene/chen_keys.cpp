@@ -100,10 +100,6 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.rayleighBeta = ray.number("beta", d.rayleighBeta, Range::nonNegative());
   ray.finish();
   g.edgeContact = r.boolean("edgeContact", d.edgeContact);
-  ObjectReader adh = r.object("adhesion");
-  g.adhesionStress = adh.number("stress", d.adhesionStress, Range::nonNegative());
-  g.adhesionRange = adh.has("range") ? adh.number("range", 0.0f, Range::nonNegative()) : d.adhesionRange;
-  adh.finish();
   ObjectReader cg = r.object("cg");
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());
   g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));

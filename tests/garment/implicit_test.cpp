@@ -237,35 +237,6 @@ TEST(GarmentImplicit, DisturbancesBuckleASqueezedSheetThatOtherwiseStaysFlat) {
   EXPECT_LT(buckledRatio, 0.1);
 }
 
-// wet adhesion (departure 16): a free sheet just under a ceiling, within the adhesion range of its
-// contact margin. Saturated, with an adhesion stress three times its weight per area, it is pulled up
-// to the ceiling and stays there; dry, or beyond the range, it falls
-TEST(GarmentImplicit, WetAdhesionHoldsASheetUnderACeiling) {
-  auto finalGap = [](float s, float startGap) {
-    Rig r;
-    const float margin = 0.5f * ClothMaterial{}.thickness;
-    makeHangingRig(r, 6, 0.2f, 1.0f - margin - startGap, {});
-    Collider ceiling;
-    ceiling.shape = ColliderShape::Plane;
-    ceiling.keys = {Keyframe{0.0f, Vec3(0, 1, 0), Quat(Eigen::AngleAxisf(kPi, Vec3::UnitX()))}};  // normal -y
-    r.model.colliders.push_back(ceiling);
-    float weight = 0.0f;
-    for (int i = 0; i < r.model.numCloth; ++i)
-      weight = std::max(weight, r.model.clothDryMass[i] * 9.81f / r.model.clothRestArea[i]);
-    r.params.adhesionStress = 3.0f * weight;
-    const std::vector<float> saturation(r.model.numCloth, s);
-    const float h = 1.0f / 60.0f;
-    for (int k = 0; k < 60; ++k) EXPECT_TRUE(stepRig(r, k * h, h, {}, saturation).converged);
-    float gap = 0.0f;
-    for (int i = 0; i < r.model.numCloth; ++i) gap = std::max(gap, 1.0f - margin - r.p.x[i].y());
-    return gap;
-  };
-  const float range = ClothMaterial{}.thickness;
-  EXPECT_LT(finalGap(1.0f, 0.5f * range), 1e-4f) << "wet: held at the ceiling";
-  EXPECT_GT(finalGap(0.0f, 0.5f * range), 0.1f) << "dry: falls";
-  EXPECT_GT(finalGap(1.0f, 1.5f * range), 0.1f) << "wet, but out of the water film's reach: falls";
-}
-
 // Eq. 15-19 through the whole stage: the saturated sheet (high absorption: 3.49 times its dry mass)
 // stretches more under its weight and hangs lower than the dry one
 TEST(GarmentImplicit, SaturatedClothHangsLowerThanDry) {

@@ -221,7 +221,6 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
       "bend": {"a1": 3, "a2": 1}, "strainLimit": 0.7, "bendStraightness": 0.6,
       "friction": {"dry": 0.2, "peak": 0.9, "plateau": 0.4, "peakSaturation": 0.15, "plateauSaturation": 0.8},
       "rayleigh": {"alpha": 0.5, "beta": 0.001}, "cg": {"tolerance": 1e-6, "maxIterations": 77},
-      "adhesion": {"stress": 7, "range": 0.012},
       "wrinkles": {"compressionThreshold": 0.1, "equilibriumSpeed": 0.3, "interval": 4, "patchSize": 50,
                    "tieTolerance": 0.01, "strength": 0.5, "dryStrength": 0.25, "seed": 9}})"});
   const GarmentParams& g = s.model.pieces[0].garment;
@@ -240,8 +239,6 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_FLOAT_EQ(g.rayleighBeta, 0.001f);
   EXPECT_FLOAT_EQ(g.cgTolerance, 1e-6f);
   EXPECT_EQ(g.cgMaxIterations, 77);
-  EXPECT_FLOAT_EQ(g.adhesionStress, 7.0f);
-  EXPECT_FLOAT_EQ(g.adhesionRange, 0.012f);
   EXPECT_TRUE(g.wrinkles.enabled);
   EXPECT_FLOAT_EQ(g.wrinkles.compressionThreshold, 0.1f);
   EXPECT_FLOAT_EQ(g.wrinkles.equilibriumSpeed, 0.3f);
@@ -258,10 +255,6 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_EQ(d.laws.shear.a1, defaults.laws.shear.a1);
   EXPECT_EQ(d.friction.peak, defaults.friction.peak);
   EXPECT_EQ(d.cgMaxIterations, defaults.cgMaxIterations);
-  EXPECT_EQ(d.adhesionStress, 4.0f);
-  EXPECT_LT(d.adhesionRange, 0.0f) << "unset: the piece's thickness";
-  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.adhesion.stress=-1"}),
-             "at cloth[0].garment.adhesion.stress: expected a number >= 0");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.wrinkles.patchSize=2"}),
              "at cloth[0].garment.wrinkles.patchSize: expected an integer >= 3, got 2");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.strainLimit=1.5"}), "at cloth[0].garment.strainLimit: expected a number in");
