@@ -33,11 +33,19 @@ Vec3 sheetNormal(const Model& m) {
   return (m.clothRestPosition[1] - m.clothRestPosition[0]).cross(m.clothRestPosition[11] - m.clothRestPosition[0]).normalized();
 }
 
-// neighbour lists on the particles' positions, as the step builds them
-void buildLists(const Particles& p, NeighborGrid& grid, NeighborLists& nb) {
-  buildGrid(p.x, 0.04f, grid);
-  buildNeighborLists(p.x, p.radius, grid, nb);
-}
+// the wet-by-contact stage on its own: neighbour lists on the particles' positions, as the step
+// builds them, then wetClothByContact at `time`; returns the particles taken
+struct WetStage {
+  NeighborGrid grid;
+  NeighborLists nb;
+  GarmentScratch scratch;
+  std::vector<uint8_t> keep;
+  size_t operator()(const Model& m, State& state, double time) {
+    buildGrid(state.particles.x, 0.04f, grid);
+    buildNeighborLists(state.particles.x, state.particles.radius, grid, nb);
+    return wetClothByContact(m, state, nb, scratch, keep, time);
+  }
+};
 
 // with an unlimited supply (Chen as printed) a drop within touchDistance (thickness + water spacing =
 // 0.028 m) of a vertex wets that vertex, and every vertex within its reach, and vanishes into the piece
@@ -56,12 +64,8 @@ TEST(GarmentStage, WithUnlimitedSupplyADropWetsTheVerticesWithinReachAndVanishes
   p.add(kWaterPhase, 1000, mass, 0.04f, x0[60] + 0.95f * reach * n, Vec3::Zero());                 // wets 60
   p.add(kWaterPhase, 1001, 0.5f * mass, 0.04f, x0[30] + 1.05f * reach * n, Vec3::Zero());         // too far
   p.add(kWaterPhase, 1002, 0.25f * mass, 0.04f, 0.5f * (x0[24] + x0[25]) + 0.01f * n, Vec3::Zero());  // 24, 25
-  NeighborGrid grid;
-  NeighborLists nb;
-  buildLists(p, grid, nb);
-  GarmentScratch scratch;
-  std::vector<uint8_t> keep;
-  const size_t taken = wetClothByContact(m, s.state, nb, scratch, keep, 0.5);
+  WetStage stage;
+  const size_t taken = stage(m, s.state, 0.5);
   EXPECT_EQ(taken, 2u);
   for (int i = 0; i < m.numCloth; ++i) {
     const bool wet = i == 60 || i == 24 || i == 25;
@@ -77,8 +81,7 @@ TEST(GarmentStage, WithUnlimitedSupplyADropWetsTheVerticesWithinReachAndVanishes
 
   // a second pass at a later time keeps the first wet times
   p.x.back() = x0[30] + 0.5f * reach * n;
-  buildLists(p, grid, nb);
-  EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 0.75), 1u);
+  EXPECT_EQ(stage(m, s.state, 0.75), 1u);
   EXPECT_EQ(s.state.clothWetStart[30], 0.75f);
   EXPECT_EQ(s.state.clothWetStart[60], 0.5f);
   EXPECT_EQ(p.size(), size_t(m.numCloth));
@@ -99,12 +102,8 @@ TEST(GarmentStage, ADropGoesIntoTheNearestVertexWithRoomAndRunsOffAFullOne) {
   p.add(kWaterPhase, 1000, mass, 0.04f, x0[60] + 0.5f * reach * n, Vec3::Zero());
   p.add(kWaterPhase, 1001, mass, 0.04f, 0.4f * x0[24] + 0.6f * x0[25] + 0.01f * n, Vec3::Zero());  // nearer 25
   s.state.clothWater[25] = capacity;  // full: the drop goes into 24 instead
-  NeighborGrid grid;
-  NeighborLists nb;
-  buildLists(p, grid, nb);
-  GarmentScratch scratch;
-  std::vector<uint8_t> keep;
-  EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 0.5), 2u);
+  WetStage stage;
+  EXPECT_EQ(stage(m, s.state, 0.5), 2u);
   EXPECT_EQ(p.size(), size_t(m.numCloth));
   for (int i = 0; i < m.numCloth; ++i) {
     EXPECT_EQ(std::isfinite(s.state.clothWetStart[size_t(i)]), i == 60 || i == 24) << i;
@@ -119,8 +118,7 @@ TEST(GarmentStage, ADropGoesIntoTheNearestVertexWithRoomAndRunsOffAFullOne) {
   // vertex 60 full: a drop right over it, with no other vertex within reach, stays
   s.state.clothWater[60] = capacity;
   p.add(kWaterPhase, 1002, mass, 0.04f, x0[60] + 0.3f * reach * n, Vec3::Zero());
-  buildLists(p, grid, nb);
-  EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 0.75), 0u);
+  EXPECT_EQ(stage(m, s.state, 0.75), 0u);
   EXPECT_EQ(p.size(), size_t(m.numCloth) + 1);
   EXPECT_EQ(s.state.clothWater[60], capacity);
 }
@@ -135,12 +133,8 @@ TEST(GarmentStage, AHeavyDropSpreadsOverTheVerticesAroundIt) {
   Particles& p = s.state.particles;
   const double capacity = waterCapacity(m.clothDryMass[60], m.pieces[0].garment.saturation);
   p.add(kWaterPhase, 1000, float(3.5 * capacity), 0.04f, m.clothRestPosition[60] + 0.01f * n, Vec3::Zero());
-  NeighborGrid grid;
-  NeighborLists nb;
-  buildLists(p, grid, nb);
-  GarmentScratch scratch;
-  std::vector<uint8_t> keep;
-  EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 0.5), 1u);
+  WetStage stage;
+  EXPECT_EQ(stage(m, s.state, 0.5), 1u);
   const std::set<int> ring(m.vertexNeighbors.begin() + m.vertexNeighborStart[60],
                            m.vertexNeighbors.begin() + m.vertexNeighborStart[61]);
   double total = 0.0;
@@ -158,8 +152,7 @@ TEST(GarmentStage, AHeavyDropSpreadsOverTheVerticesAroundIt) {
   EXPECT_NEAR(total, double(float(3.5 * capacity)), 1e-12);
   const float flood = float(300.0 * capacity);
   p.add(kWaterPhase, 1001, flood, 0.04f, m.clothRestPosition[20] + 0.01f * n, Vec3::Zero());
-  buildLists(p, grid, nb);
-  EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 0.75), 0u);
+  EXPECT_EQ(stage(m, s.state, 0.75), 0u);
   EXPECT_EQ(p.size(), size_t(m.numCloth) + 1);
   EXPECT_FALSE(std::isfinite(s.state.clothWetStart[20]));
 }
@@ -172,12 +165,8 @@ TEST(GarmentStage, DropsThatStayAndShaoWettingDecideTheWetSignalOtherwise) {
     const Model& m = s.model;
     s.state.particles.add(kWaterPhase, 1000, m.water.particleMass, 0.04f,
                           m.clothRestPosition[60] + 0.01f * sheetNormal(m), Vec3::Zero());
-    NeighborGrid grid;
-    NeighborLists nb;
-    buildLists(s.state.particles, grid, nb);
-    GarmentScratch scratch;
-    std::vector<uint8_t> keep;
-    EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 1.0), 0u);
+    WetStage stage;
+    EXPECT_EQ(stage(m, s.state, 1.0), 0u);
     EXPECT_EQ(s.state.clothWetStart[60], 1.0f);
     EXPECT_EQ(s.state.particles.size(), size_t(m.numCloth) + 1);
     EXPECT_EQ(s.state.ledger.takenByCloth, 0.0);
@@ -188,12 +177,8 @@ TEST(GarmentStage, DropsThatStayAndShaoWettingDecideTheWetSignalOtherwise) {
     s.state.particles.add(kWaterPhase, 1000, m.water.particleMass, 0.04f,
                           m.clothRestPosition[60] + 0.01f * sheetNormal(m), Vec3::Zero());
     s.state.clothWater[7] = 1e-7;
-    NeighborGrid grid;
-    NeighborLists nb;
-    buildLists(s.state.particles, grid, nb);
-    GarmentScratch scratch;
-    std::vector<uint8_t> keep;
-    EXPECT_EQ(wetClothByContact(m, s.state, nb, scratch, keep, 2.0), 0u);
+    WetStage stage;
+    EXPECT_EQ(stage(m, s.state, 2.0), 0u);
     for (int i = 0; i < m.numCloth; ++i)
       EXPECT_EQ(std::isfinite(s.state.clothWetStart[size_t(i)]), i == 7) << i;
     EXPECT_EQ(s.state.clothWetStart[7], 2.0f);
