@@ -9,6 +9,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include <bit>
 #include <cstring>
 #include <filesystem>
@@ -229,12 +231,14 @@ void checkCheckpointFits(const std::string& path, const Checkpoint& c, const Mod
     if (!isWater(s.particles.phase[i])) fail(fmt::format("particle {} after the cloth is not water", i));
   if (s.emitters.size() != model.emitters.size())
     fail(fmt::format("{} emitters, the scene has {}", s.emitters.size(), model.emitters.size()));
-  // Shao's wetting, or Chen's held water and saturation (a piece wetted by contact) use them
-  const size_t wet = model.wetting.enabled || !s.clothWetStart.empty() ? nc : 0;
+  // a piece wetted by contact (Chen 2012) keeps wet times, held water and saturation; Shao's wetting
+  // the water arrays
+  const bool chen = std::any_of(model.pieces.begin(), model.pieces.end(), [](const ClothPiece& p) { return p.wetByContact; });
+  const size_t wet = model.wetting.enabled || chen ? nc : 0;
   if (s.clothWater.size() != wet || s.clothBuffer.size() != wet || s.clothSaturation.size() != wet)
     fail(fmt::format("wetting arrays of {} entries, expected {}", s.clothWater.size(), wet));
-  if (!s.clothWetStart.empty() && s.clothWetStart.size() != nc)
-    fail(fmt::format("{} wet start times, expected {}", s.clothWetStart.size(), nc));
+  if (s.clothWetStart.size() != (chen ? nc : 0))
+    fail(fmt::format("{} wet start times, expected {}", s.clothWetStart.size(), chen ? nc : 0));
   if (s.dripId.size() != s.dripSource.size()) fail("drip arrays of different lengths");
 }
 

@@ -82,7 +82,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.friction.peakSaturation = f.number("peakSaturation", d.friction.peakSaturation, Range{0.0, 1.0, true, true});
   g.friction.plateauSaturation =
       f.number("plateauSaturation", d.friction.plateauSaturation, Range{0.0, 1.0, true, false});
-  for (const char* key : {"tau1", "tau2", "timeScale"})  // the curve was over time since the first drop
+  for (const char* key : {"tau1", "tau2", "timeScale"})  // a curve over time: this one follows the saturation
     if (f.has(key))
       log.error(f.pathOf(key), "expected no times: the friction curve follows the saturation (give peakSaturation "
                                "and plateauSaturation in (0, 1]; docs/scene-format.md)");

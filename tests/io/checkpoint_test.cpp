@@ -152,6 +152,18 @@ TEST(Checkpoint, AStateOfAnotherSceneDoesNotFit) {
   expectError([&] { checkCheckpointFits(path, c, b.model); }, {path, "does not belong to this scene"});
   const Scene chen = sceneFromFile("scenes/chen_fig8_silk_sphere_wet.json");
   expectError([&] { checkCheckpointFits(path, c, chen.model); }, {path, "does not belong to this scene"});
+  // a Chen piece keeps its held water, saturation and wet times: a state without them does not fit
+  const std::string chenPath = (dir / "chen.soak").string();
+  writeCheckpoint(chenPath, infoAt(0, 0), chen.state);
+  Checkpoint cc = readCheckpoint(chenPath);
+  EXPECT_NO_THROW(checkCheckpointFits(chenPath, cc, chen.model));
+  cc.state.clothWater.clear();
+  cc.state.clothBuffer.clear();
+  cc.state.clothSaturation.clear();
+  expectError([&] { checkCheckpointFits(chenPath, cc, chen.model); }, {chenPath, "wetting arrays of 0 entries, expected 2601"});
+  cc = readCheckpoint(chenPath);
+  cc.state.clothWetStart.clear();
+  expectError([&] { checkCheckpointFits(chenPath, cc, chen.model); }, {chenPath, "0 wet start times, expected 2601"});
 }
 
 }  // namespace
