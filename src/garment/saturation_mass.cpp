@@ -24,6 +24,15 @@ constexpr Preset kPresets[] = {
     {"high_absorption", 2.492f, 3.3803f},
 };
 
+// the time constant of Eq. 18 in seconds
+double timeConstant(const SaturationParams& s) { return static_cast<double>(s.a3) * s.timeScale; }
+
+// Eq. 18 over delta: 1 - exp(-t / a3), 0 before the fabric is wet (or never)
+double saturationAfter(double wetTime, const SaturationParams& s) {
+  if (!(wetTime > 0.0) || !std::isfinite(wetTime)) return 0.0;
+  return -std::expm1(-wetTime / timeConstant(s));
+}
+
 }  // namespace
 
 const std::vector<std::string>& saturationPresetNames() {
@@ -44,28 +53,22 @@ SaturationParams saturationPreset(const std::string& name, const std::string& wh
               "; or give saturation.delta and saturation.a3 explicitly)");
 }
 
-double absorbedRatio(double wetTime, const SaturationParams& s) {
-  if (!(wetTime > 0.0)) return 0.0;
-  const double tau = static_cast<double>(s.a3) * s.timeScale;
-  return s.delta * -std::expm1(-wetTime / tau);  // Eq. 18
-}
+double absorbedRatio(double wetTime, const SaturationParams& s) { return s.delta * saturationAfter(wetTime, s); }
 
 double absorptionRate(double wetTime, const SaturationParams& s) {
   if (!(wetTime >= 0.0)) return 0.0;
-  const double tau = static_cast<double>(s.a3) * s.timeScale;
+  const double tau = timeConstant(s);
   return s.delta / tau * std::exp(-wetTime / tau);  // Eq. 19
 }
 
 float unlimitedSaturation(double wetTime, const SaturationParams& s) {
-  if (!(wetTime > 0.0) || !std::isfinite(wetTime)) return 0.0f;
-  return static_cast<float>(-std::expm1(-wetTime / (static_cast<double>(s.a3) * s.timeScale)));  // Eq. 18 / delta
+  return static_cast<float>(saturationAfter(wetTime, s));
 }
 
 float absorbStep(float saturation, double heldFraction, double h, const SaturationParams& s) {
   const double target = std::clamp(heldFraction, 0.0, 1.0);
   if (!(target > saturation)) return saturation;  // absorbed water stays absorbed
-  const double tau = static_cast<double>(s.a3) * s.timeScale;
-  return static_cast<float>(saturation + (target - saturation) * -std::expm1(-h / tau));  // Eq. 18's ODE
+  return static_cast<float>(saturation + (target - saturation) * -std::expm1(-h / timeConstant(s)));  // Eq. 18's ODE
 }
 
 double waterCapacity(double dryMass, const SaturationParams& s) { return static_cast<double>(s.delta) * dryMass; }
@@ -98,12 +101,6 @@ void updateSaturation(const Model& model, int piece, const SaturationParams& s, 
     const double capacity = waterCapacity(model.clothDryMass[i], s);
     sat = absorbStep(sat, capacity > 0.0 ? state.clothWater[i] / capacity : 0.0, h, s);
   });
-}
-
-void markWet(std::span<const uint8_t> wet, double time, std::span<float> wetStart) {
-  const size_t n = std::min(wet.size(), wetStart.size());
-  for (size_t v = 0; v < n; ++v)
-    if (wet[v] && !std::isfinite(wetStart[v])) wetStart[v] = static_cast<float>(time);
 }
 
 }  // namespace soak

@@ -54,7 +54,5 @@ void applySaturationMass(const Model& model, int piece, std::span<const float> s
 // (State::clothWater). Needs both arrays sized to the cloth (a piece with wetByContact).
 void updateSaturation(const Model& model, int piece, const SaturationParams& s, double time, float h, State& state);
 
-// records the first wet time: wetStart[v] = time for each v < min(sizes) with wet[v] != 0 that was dry
-void markWet(std::span<const uint8_t> wet, double time, std::span<float> wetStart);
 
 }  // namespace soak

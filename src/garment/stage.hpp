@@ -48,7 +48,8 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
 // 0) and nothing else happens here. Without it, a water particle within touchDistance(piece) of a
 // vertex that still takes water soaks into the fabric from the nearest such vertex: into its
 // clothWater up to delta m_dry, the rest into its mesh neighbours with room, nearest rings first
-// (every vertex that gets water is wet). Rain on fabric with no room for it stays water and runs off. A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
+// (every vertex that gets water is wet). Rain on fabric with no room for it stays water and runs off.
+// A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
 // reaches, and the particle vanishes when the piece has dropsVanish (WaterLedger::takenByCloth).
 // time is the end of the substep. Returns the number of water particles taken.
 size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,

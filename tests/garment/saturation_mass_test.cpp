@@ -1,5 +1,5 @@
 // Chen 2012 saturation mass (section 3.3, Eq. 15-19, Table 1): the presets, Q(t) of Eq. 18 and its rate
-// (Eq. 19), the first wet time per vertex, and the wet mass set on one cloth piece
+// (Eq. 19), the saturation a vertex absorbs from the water it holds, and the wet mass set on one piece
 #include "garment/saturation_mass.hpp"
 
 #include <soak/error.hpp>
@@ -180,25 +180,6 @@ TEST(GarmentSaturation, RateIsTheDerivativeOfQ) {
         EXPECT_NEAR(slope, absorptionRate(t, s), 1e-7 * absorptionRate(t, s)) << name << " t " << t;
       }
     }
-}
-
-// markWet keeps the first wet time of each vertex, ignores dry entries, and touches only the vertices both
-// spans hold
-TEST(GarmentSaturation, MarkWetKeepsTheFirstTimeWithinBothSpans) {
-  std::vector<float> start(5, kNeverWet);
-  const std::vector<uint8_t> first{0, 1, 0, 1, 0};
-  markWet(first, 1.5, start);
-  EXPECT_EQ(start, (std::vector<float>{kNeverWet, 1.5f, kNeverWet, 1.5f, kNeverWet}));
-  const std::vector<uint8_t> all(5, 1);
-  markWet(all, 2.25, start);  // 1 and 3 keep 1.5
-  EXPECT_EQ(start, (std::vector<float>{2.25f, 1.5f, 2.25f, 1.5f, 2.25f}));
-  // a shorter wet span leaves the rest; a shorter start span is not overrun
-  std::vector<float> fresh(4, kNeverWet);
-  markWet(std::vector<uint8_t>{1, 1}, 7.0, fresh);
-  EXPECT_EQ(fresh, (std::vector<float>{7.0f, 7.0f, kNeverWet, kNeverWet}));
-  std::vector<float> two(2, kNeverWet);
-  markWet(all, 8.0, two);
-  EXPECT_EQ(two, (std::vector<float>{8.0f, 8.0f}));
 }
 
 // applySaturationMass writes the masses of its own piece only (saturation indexed from the piece's first
