@@ -7,11 +7,12 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev
           libtinyobjloader-dev libgtest-dev libgmock-dev
-          libopenvdb-dev libboost-iostreams-dev zlib1g-dev povray ffmpeg
+          libopenvdb-dev libboost-iostreams-dev zlib1g-dev libcgal-dev povray ffmpeg
           python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
           clang libclang-rt-14-dev libomp-14-dev
           munge slurmctld slurmd slurm-client)
 # zlib1g-dev: OpenVDB's CMake module (FindOpenVDB.cmake) requires ZLIB but its package does not depend on it.
+# libcgal-dev: the sewing patterns' triangulation (src/world/pattern.cpp)
 # python3-*, pybind11-dev: the Python module (python/), its tests (pytest) and example (matplotlib)
 # clang, libclang-rt-14-dev (libFuzzer, the sanitizers) and libomp-14-dev (clang's OpenMP): the fuzz
 # targets of tests/fuzz/, built by scripts/fuzz.sh

@@ -8,7 +8,7 @@ set(SOAK_FUZZ_FLAGS -fsanitize=address,undefined -fno-sanitize-recover=undefined
 add_library(soak_fuzz_lib STATIC ${SOAK_SOURCES})
 target_include_directories(soak_fuzz_lib PUBLIC ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/src)
 target_link_libraries(soak_fuzz_lib PUBLIC Eigen3::Eigen nlohmann_json::nlohmann_json fmt::fmt
-                      tinyobjloader::tinyobjloader OpenMP::OpenMP_CXX)
+                      tinyobjloader::tinyobjloader OpenMP::OpenMP_CXX CGAL::CGAL)
 target_compile_options(soak_fuzz_lib PUBLIC ${SOAK_FUZZ_FLAGS} PRIVATE -fsanitize=fuzzer-no-link)
 target_link_options(soak_fuzz_lib PUBLIC -fsanitize=address,undefined)
 foreach(target scene obj)
