@@ -23,6 +23,9 @@ struct SpringLaws {
   // Eq. 11 is followed up to |eps| = strainLimit / a2 and continued by its tangent beyond, so the
   // pole at 1/a2 is never reached (departure, docs/garment.md)
   float strainLimit = 0.9f;
+  // N/m, a seam's pull per metre of gap (seamForce, garment/springs.hpp); the scene loader gives it the
+  // stretch law's a1 unless the scene sets garment.seams.stiffness
+  float seamStiffness = 2000.0f;
 };
 
 struct SpringBuildOptions {
@@ -60,6 +63,12 @@ struct WrinkleParams {
   float dryStrength = 0.0f;            // the same for a dry vertex, [0, strength]; linear in the saturation between
 };
 
+// a sewn garment's seams (world/pattern.hpp) close during the first moments of the run
+struct SeamParams {
+  float closeTime = 0.5f;            // s: each seam's rest length shrinks linearly from its starting gap to 0
+  bool gravityWhileClosing = false;  // false: the piece feels no gravity before closeTime, as garment tools sew
+};
+
 // everything the implicit garment solver of one cloth piece reads (implicit.hpp)
 struct GarmentParams {
   SpringLaws laws;                    // KES laws (Eq. 11, 14)
@@ -67,6 +76,7 @@ struct GarmentParams {
   SaturationParams saturation;        // Eq. 18, Table 1 (cotton by default)
   WetFrictionParams friction;         // Fig. 5
   WrinkleParams wrinkles;             // section 3.5 (off by default)
+  SeamParams seams;                   // a sewn garment's seams (ClothPiece::seams)
   bool saturationMass = true;         // garmentSubstep sets the mass by Eq. 15-19; false: the mass is
                                       // left to another model (Shao 2017 absorption)
   float rayleighAlpha = 0.0f;         // 1/s, mass-proportional damping, >= 0 (the paper's -9 is a typo: NOTES.md)

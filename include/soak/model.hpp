@@ -89,6 +89,7 @@ struct ClothPiece {
   bool wetByContact = false;        // the piece keeps a wet start time per vertex (State::clothWetStart)
   bool dropsVanish = true;          // a water particle that wets the piece (no Shao wetting) is taken in
   std::vector<int> panelOfVertex;   // wrinkle subdomains of a procedural garment; empty: patches
+  std::vector<std::array<int, 2>> seams;  // local vertex pairs a sewn garment's seams pull together (implicit)
   // Implicit pieces: their constant garment data, built by the scene loader (buildGarmentPieces);
   // shared and read-only, so a Model copy stays cheap
   std::shared_ptr<const GarmentPiece> implicit;

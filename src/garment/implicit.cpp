@@ -88,10 +88,10 @@ GarmentPiece buildGarmentPiece(const Model& model, int piece, const GarmentParam
 
 namespace {
 
-// forces and stiffness per spring (Eq. 12-13), each spring writes only its own slot; the strain range
-// of the stretch springs to stats
-void springForces(const GarmentPiece& g, const GarmentParams& params, const Particles& p, ImplicitScratch& w,
-                  ImplicitStats& stats) {
+// forces and stiffness per spring (Eq. 12-13; a seam's pull towards `seamOpen` times its starting
+// gap), each spring writes only its own slot; the strain range of the stretch springs to stats
+void springForces(const GarmentPiece& g, const GarmentParams& params, float seamOpen, const Particles& p,
+                  ImplicitScratch& w, ImplicitStats& stats) {
   const SpringSet& sp = g.springs;
   const int ns = sp.size();
   const size_t first = static_cast<size_t>(g.firstParticle);
@@ -99,8 +99,14 @@ void springForces(const GarmentPiece& g, const GarmentParams& params, const Part
   w.springStiffness.resize(static_cast<size_t>(ns));
   w.strain.resize(static_cast<size_t>(ns));
   parallelFor(ns, [&](int64_t s) {
-    w.strain[s] = springForce(sp, params.laws, static_cast<int>(s), p.x[first + sp.ids[s][0]], p.x[first + sp.ids[s][1]],
-                              w.springForce[s], &w.springStiffness[s]);
+    const Vec3& xi = p.x[first + sp.ids[s][0]];
+    const Vec3& xj = p.x[first + sp.ids[s][1]];
+    if (s >= sp.kindStart[3]) {
+      seamForce(params.laws.seamStiffness, seamOpen * sp.restLength[s], xi, xj, w.springForce[s], &w.springStiffness[s]);
+      w.strain[s] = 0.0f;
+      return;
+    }
+    w.strain[s] = springForce(sp, params.laws, static_cast<int>(s), xi, xj, w.springForce[s], &w.springStiffness[s]);
   });
   if (sp.kindStart[1] > 0) {
     const auto [lo, hi] = std::minmax_element(w.strain.begin(), w.strain.begin() + sp.kindStart[1]);
@@ -131,14 +137,15 @@ void constrainRows(const Model& model, const GarmentPiece& g, const std::vector<
   for (uint8_t c : w.constrained) stats.constrainedVertices += c ? 1 : 0;
 }
 
-// A = M (1 + h alpha) + (h beta + h^2) K, b = h (f0 + h df/dx v0), gathered per row (Eq. 3-4)
+// A = M (1 + h alpha) + (h beta + h^2) K, b = h (f0 + h df/dx v0), gathered per row (Eq. 3-4);
+// gravityScale 0 while a sewn garment's seams close (SeamParams::gravityWhileClosing)
 void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentParams& params, const Particles& p,
-                    double hd, ImplicitScratch& w) {
+                    double hd, double gravityScale, ImplicitScratch& w) {
   const SpringSet& sp = g.springs;
   const size_t first = static_cast<size_t>(g.firstParticle);
   const double alpha = params.rayleighAlpha, beta = params.rayleighBeta;
   const double kScale = hd * beta + hd * hd;  // coefficient of K in A: h beta (damping) + h^2 (df/dx)
-  const Vec3d gravity = model.solver.gravity.cast<double>();
+  const Vec3d gravity = gravityScale * model.solver.gravity.cast<double>();
   w.A.rows = g.count;
   w.A.rowStart = g.rowStart;
   w.A.col = g.col;
@@ -267,14 +274,19 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
 
 }  // namespace
 
-ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
+float seamOpenFraction(const SeamParams& seams, double time) {
+  return seams.closeTime > 0.0f ? static_cast<float>(std::max(0.0, 1.0 - time / seams.closeTime)) : 0.0f;
+}
+
+ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h, double time,
                            const std::vector<ColliderPose>& poses, std::span<const float> saturation,
                            const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
   ImplicitStats stats;
   const double hd = h;
-  springForces(g, params, p, w, stats);
+  const bool sewing = g.springs.kindStart[4] > g.springs.kindStart[3] && time < params.seams.closeTime;
+  springForces(g, params, seamOpenFraction(params.seams, time), p, w, stats);
   constrainRows(model, g, constraints, p, hd, w, stats);
-  assembleSystem(model, g, params, p, hd, w);
+  assembleSystem(model, g, params, p, hd, sewing && !params.seams.gravityWhileClosing ? 0.0 : 1.0, w);
   CgOptions opt;
   opt.tolerance = params.cgTolerance;
   opt.maxIterations = params.cgMaxIterations;
@@ -290,12 +302,12 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
 }
 
 ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
-                             std::span<const float> saturation, float h, uint64_t stepIndex,
+                             std::span<const float> saturation, float h, double time, uint64_t stepIndex,
                              const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch) {
   if (params.saturationMass) applySaturationMass(model, g.piece, saturation, params.saturation, p);  // Eq. 15-19
   const std::vector<PositionConstraint> wrinkles = computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses,
                                                                        params.wrinkles, stepIndex, saturation);  // 3.5
-  ImplicitStats s = implicitStep(model, g, params, h, poses, saturation, wrinkles, p, scratch);  // Eq. 1-5
+  ImplicitStats s = implicitStep(model, g, params, h, time, poses, saturation, wrinkles, p, scratch);  // Eq. 1-5
   s.disturbances = static_cast<int>(wrinkles.size());
   return s;
 }

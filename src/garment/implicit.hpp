@@ -7,11 +7,11 @@
 // solve, collider contact with the wet friction of Fig. 5 (wet_friction.hpp).
 //
 // Use from the step, for a piece whose scene says "solver": "implicit" (docs/garment.md): one call
-//   ImplicitStats s = garmentSubstep(model, g, params, saturation, h, stepIndex, poses, p, scratch);
+//   ImplicitStats s = garmentSubstep(model, g, params, saturation, h, time, stepIndex, poses, p, scratch);
 // which is
 //   applySaturationMass(model, k, saturation, params.saturation, p);      // Eq. 15-19
 //   auto wr = computeDisturbances(model, k, g.springs, g.subdomains, p, poses, params.wrinkles, step, saturation);
-//   implicitStep(model, g, params, h, poses, saturation, wr, p, scratch);  // Eq. 1-5, contact
+//   implicitStep(model, g, params, h, time, poses, saturation, wr, p, scratch);  // Eq. 1-5, contact
 // It reads x, v, mass of the piece and writes xPred (= x1) and v (= v1); x is left for the caller's
 // commit (x = xPred). The PBD stages leave the piece alone: predictPositions, solveCloth and
 // updateVelocities move only the particles of pbdParticles (pbd/integrate.hpp).
@@ -75,17 +75,19 @@ struct ImplicitStats {
   float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
 };
 
-// one implicit step of length h for the piece (see the header comment). saturation (piece-local, in
-// [0, 1], empty = all dry) sets each vertex's friction with wetFriction; poses are the
-// colliders at time + h. Deterministic for any thread count.
-ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
+// one implicit step of length h from `time` for the piece (see the header comment); seams pull towards
+// their starting gap times max(0, 1 - time / closeTime), and gravity is off while they close unless
+// params.seams.gravityWhileClosing. saturation (piece-local, in [0, 1], empty = all dry) sets each
+// vertex's friction with wetFriction; poses are the colliders at time + h. Deterministic for any
+// thread count.
+ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h, double time,
                            const std::vector<ColliderPose>& poses, std::span<const float> saturation,
                            const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& scratch);
 
-// the garment stage of one piece for one step of length h (see the header comment); stepIndex paces
-// the wrinkle disturbances
+// the garment stage of one piece for one step of length h from `time` (s; it paces the seams'
+// closing, SeamParams) (see the header comment); stepIndex paces the wrinkle disturbances
 ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
-                             std::span<const float> saturation, float h, uint64_t stepIndex,
+                             std::span<const float> saturation, float h, double time, uint64_t stepIndex,
                              const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch);
 
 // kinetic + gravitational + elastic energy of the piece (J), for tests and diagnostics

@@ -122,6 +122,25 @@ void appendSprings(SpringSet& out, const std::vector<Vec3>& rest, const std::vec
   out.kindStart[3] = out.size();
 }
 
+// the seams after the mesh springs: rest length = the starting gap, no width
+void appendSeams(SpringSet& out, const std::vector<Vec3>& rest, const std::vector<std::array<int, 2>>& seams) {
+  std::vector<int64_t> taken;
+  for (const auto& id : out.ids) taken.push_back(pairKey(id[0], id[1]));
+  std::sort(taken.begin(), taken.end());
+  std::vector<int64_t> added;
+  for (const auto& pr : seams) {
+    const int64_t key = pairKey(pr[0], pr[1]);
+    if (pr[0] == pr[1] || std::binary_search(taken.begin(), taken.end(), key)) continue;
+    if (std::find(added.begin(), added.end(), key) != added.end()) continue;
+    added.push_back(key);
+    const int lo = std::min(pr[0], pr[1]), hi = std::max(pr[0], pr[1]);
+    out.ids.push_back({lo, hi});
+    out.restLength.push_back((rest[hi] - rest[lo]).norm());
+    out.width.push_back(0.0f);
+  }
+  out.kindStart[4] = out.size();
+}
+
 // the CSR of the springs at each vertex (counts, prefix sums, then each spring in ascending order)
 void indexSpringsByVertex(SpringSet& out) {
   const int n = out.numVertices;
@@ -142,7 +161,7 @@ void indexSpringsByVertex(SpringSet& out) {
 }  // namespace
 
 SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::array<int, 3>>& triangles,
-                       const SpringBuildOptions& options) {
+                       const SpringBuildOptions& options, const std::vector<std::array<int, 2>>& seams) {
   std::vector<double> triArea;
   const std::vector<HalfEdge> half = sortedHalfEdges(rest, triangles, triArea);
   std::vector<Candidate> stretch, shear;
@@ -160,6 +179,7 @@ SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::arr
   out.numVertices = static_cast<int>(rest.size());
   const std::vector<Candidate>* const kinds[3] = {&stretch, &shear, &bend};
   appendSprings(out, rest, kinds);
+  appendSeams(out, rest, seams);
   indexSpringsByVertex(out);
   return out;
 }
@@ -171,7 +191,7 @@ SpringSet buildPieceSprings(const Model& model, int piece, const SpringBuildOpti
   std::vector<std::array<int, 3>> tris(static_cast<size_t>(pc.triangleCount));
   for (int t = 0; t < pc.triangleCount; ++t)
     for (int k = 0; k < 3; ++k) tris[t][k] = model.triangles[pc.firstTriangle + t][k] - pc.firstParticle;
-  return buildSprings(rest, tris, options);
+  return buildSprings(rest, tris, options, pc.seams);
 }
 
 float kesStretchStress(float eps, const KesLaw& law, float strainLimit, float* dsigma) {
@@ -237,12 +257,35 @@ float springStress(const SpringSet& springs, const SpringLaws& laws, int s, floa
       return kesStretchStress(eps, laws.shear, laws.strainLimit, dsigma);
     case SpringKind::Bend:
       return kesBendStress(eps, laws.bend, dsigma);
+    case SpringKind::Seam:
+      break;
   }
+  if (dsigma) *dsigma = 0.0f;
   return 0.0f;
+}
+
+void seamForce(float k, float r, const Vec3& xi, const Vec3& xj, Vec3d& fi, Eigen::Matrix3d* K) {
+  const Vec3d d = (xj - xi).cast<double>();
+  const double l = d.norm();
+  if (!(l > 1e-9)) {
+    fi.setZero();
+    if (K) *K = double(k) * Eigen::Matrix3d::Identity();
+    return;
+  }
+  const Vec3d u = d / l;
+  fi = (double(k) * (l - r)) * u;
+  if (K) {
+    const Eigen::Matrix3d uu = u * u.transpose();
+    *K = double(k) * (uu + (std::max(l - r, 0.0) / l) * (Eigen::Matrix3d::Identity() - uu));
+  }
 }
 
 float springForce(const SpringSet& springs, const SpringLaws& laws, int s, const Vec3& xi, const Vec3& xj, Vec3d& fi,
                   Eigen::Matrix3d* K) {
+  if (springs.kind(s) == SpringKind::Seam) {
+    seamForce(laws.seamStiffness, 0.0f, xi, xj, fi, K);
+    return 0.0f;
+  }
   const double l0 = springs.restLength[s];
   const double L0 = springs.width[s];
   const Vec3d d = (xj - xi).cast<double>();
@@ -272,6 +315,10 @@ float springForce(const SpringSet& springs, const SpringLaws& laws, int s, const
 double elasticEnergy(const SpringSet& springs, const SpringLaws& laws, const Vec3* x) {
   double e = 0.0;
   for (int s = 0; s < springs.size(); ++s) {
+    if (springs.kind(s) == SpringKind::Seam) {  // closed: 1/2 k l^2
+      e += 0.5 * laws.seamStiffness * (x[springs.ids[s][1]] - x[springs.ids[s][0]]).cast<double>().squaredNorm();
+      continue;
+    }
     const double l0 = springs.restLength[s];
     const double eps = ((x[springs.ids[s][1]] - x[springs.ids[s][0]]).cast<double>().norm() - l0) / l0;
     double w = 0.0;
@@ -284,6 +331,8 @@ double elasticEnergy(const SpringSet& springs, const SpringLaws& laws, const Vec
         break;
       case SpringKind::Bend:
         w = kesBendEnergy(eps, laws.bend);
+        break;
+      case SpringKind::Seam:
         break;
     }
     e += springs.width[s] * l0 * w;

@@ -192,7 +192,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
       continue;
     }
     if (!piece.implicit) continue;  // a Model built without the loader's buildGarmentPieces
-    const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, saturation, h,
+    const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, saturation, h, state.time,
                                            state.stepCount, poses, p, s.scratch[k]);
     ++gs.solves;
     gs.cgIterations += static_cast<uint64_t>(r.cgIterations);

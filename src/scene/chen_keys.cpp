@@ -100,6 +100,11 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.rayleighBeta = ray.number("beta", d.rayleighBeta, Range::nonNegative());
   ray.finish();
   g.edgeContact = r.boolean("edgeContact", d.edgeContact);
+  ObjectReader seams = r.object("seams");  // a sewn garment's (pattern meshes)
+  g.seams.closeTime = seams.number("closeTime", d.seams.closeTime, Range::nonNegative());
+  g.laws.seamStiffness = seams.number("stiffness", g.laws.stretch.a1, Range::positive());  // N/m; an edge's
+  g.seams.gravityWhileClosing = seams.boolean("gravityWhileClosing", d.seams.gravityWhileClosing);
+  seams.finish();
   ObjectReader cg = r.object("cg");
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());
   g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));

@@ -4,6 +4,7 @@
 #include <soak/error.hpp>
 
 #include "scene/common.hpp"
+#include "scene/pattern_keys.hpp"
 
 #include <fmt/format.h>
 
@@ -65,16 +66,37 @@ int nearestVertex(const TriangleMesh& mesh, const Vec3& p) {
 const std::vector<std::string> kRectangleKeys = {"center", "size", "resolution", "axisU", "axisV"};
 const std::vector<std::string> kObjKeys = {"path", "scale", "translate", "rotate"};
 
-// reads "mesh" and builds the triangle mesh; nullopt when it is invalid (errors logged)
+// a sewn garment (world/pattern.hpp): its panels and seams into spec; only the implicit solver sews
+std::optional<TriangleMesh> readPatternPiece(ObjectReader& m, const std::string& baseDir, const ParticleLimit& limit,
+                                             const Bodies& bodies, ClothSolver solver, ClothSpec& spec) {
+  std::optional<SewnGarment> g = readPatternMesh(m, baseDir, bodies, limit);
+  m.finish(concat(concat(kRectangleKeys, kObjKeys), kGarmentMeshKeys), "a pattern mesh");
+  if (solver != ClothSolver::Implicit)
+    m.log().error(m.path(), "expected \"solver\": \"implicit\" on the piece (a pattern's seams are springs of the "
+                            "implicit solver), got a pattern mesh on a PBD piece");
+  if (!g) return std::nullopt;
+  if (int64_t(g->mesh.vertices.size()) > limit.count) {
+    m.log().error(m.path(), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
+                                        g->mesh.vertices.size()));
+    return std::nullopt;
+  }
+  spec.panelOfVertex = std::move(g->panelOfVertex);
+  spec.seams = std::move(g->seamPairs);
+  return std::move(g->mesh);
+}
+
+// reads "mesh" and builds the triangle mesh (a garment's panels and seams into spec); nullopt when
+// it is invalid (errors logged)
 std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir, const ParticleLimit& limit,
-                                     std::optional<RectangleInfo>& rect, const Bodies& bodies,
-                                     std::vector<int>& panelOfVertex) {
+                                     std::optional<RectangleInfo>& rect, const Bodies& bodies, ClothSolver solver,
+                                     ClothSpec& spec) {
   ErrorLog& log = m.log();
   const size_t errorsBefore = log.messages().size();
-  const int type = m.choice("type", {"rectangle", "obj", "garment"}, std::nullopt);
+  const int type = m.choice("type", {"rectangle", "obj", "garment", "pattern"}, std::nullopt);
+  if (type == 3) return readPatternPiece(m, baseDir, limit, bodies, solver, spec);
   if (type == 2) {
-    std::optional<TriangleMesh> mesh = readGarmentMesh(m, bodies, panelOfVertex);
-    m.finish(concat(kRectangleKeys, kObjKeys), "a garment mesh");
+    std::optional<TriangleMesh> mesh = readGarmentMesh(m, bodies, spec.panelOfVertex);
+    m.finish(concat(concat(kRectangleKeys, kObjKeys), {"pattern"}), "a garment mesh");
     if (mesh && int64_t(mesh->vertices.size()) > limit.count) {
       log.error(m.path(), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
                                       mesh->vertices.size()));
@@ -88,7 +110,7 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
     const std::vector<int> res = m.integers("resolution", 2, std::nullopt, Range::atLeast(2));
     const Vec3 u = m.unitVec3("axisU", Vec3::UnitX());
     const Vec3 v = m.unitVec3("axisV", Vec3::UnitZ());
-    m.finish(concat(kObjKeys, kGarmentMeshKeys), "a rectangle mesh");
+    m.finish(concat(concat(kObjKeys, kGarmentMeshKeys), {"pattern"}), "a rectangle mesh");
     if (std::abs(u.dot(v)) > 1e-3f)
       log.error(m.pathOf("axisV"), fmt::format("expected a direction perpendicular to axisU {}, got {}", fmtVec(u),
                                                fmtVec(v)));
@@ -109,7 +131,7 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
     const float scale = m.number("scale", 1.0f, Range::positive());
     const Vec3 translate = m.vec3("translate", Vec3::Zero());
     const Quat rotate = readRotation(m.object("rotate"));
-    m.finish(concat(kRectangleKeys, kGarmentMeshKeys), "an obj mesh");
+    m.finish(concat(concat(kRectangleKeys, kGarmentMeshKeys), {"pattern"}), "an obj mesh");
     if (log.messages().size() != errorsBefore) return std::nullopt;
     const fs::path resolved(resolvePath(file, baseDir));
     std::error_code ec;
@@ -199,7 +221,7 @@ std::optional<ClothSpec> readCloth(ErrorLog& log, const Json& v, const std::stri
   const ClothSolver solver = readClothSolver(r);
   std::optional<RectangleInfo> rect;
   std::optional<TriangleMesh> mesh =
-      readMesh(r.object("mesh", true), baseDir, limit, rect, bodies, spec.panelOfVertex);
+      readMesh(r.object("mesh", true), baseDir, limit, rect, bodies, solver, spec);
   spec.material = readMaterial(r.object("material"), solver);
   spec.pinned = readPins(r.object("pin"), mesh ? &*mesh : nullptr, rect);
   spec.chen = readChenCloth(r, solver, shaoWetting);

@@ -23,6 +23,7 @@ struct ClothSpec {
   std::vector<int> pinned;  // mesh vertex indices, sorted, unique
   ChenClothSpec chen;       // solver, saturation mass, garment settings (Chen 2012)
   std::vector<int> panelOfVertex;
+  std::vector<std::array<int, 2>> seams;  // a sewn garment's vertex pairs (mesh indices)
 };
 
 // reads cloth[index] (v, at JSON path `path`); nullopt when it is invalid (errors logged). Meshes

@@ -47,6 +47,8 @@ class ErrorLog {
   void error(const std::string& path, const std::string& what);
   // "<file>: at <path>: expected <expected>, got <describeJson(got)>"
   void expected(const std::string& path, const std::string& expected, const Json& got);
+  // a message already formatted for another file (a pattern file the scene names), kept as it is
+  void add(std::string message) { messages_.push_back(std::move(message)); }
   bool ok() const { return messages_.empty(); }
   const std::vector<std::string>& messages() const { return messages_; }
   // throws soak::Error with the messages, one a line (the first 50, then a count), when any was recorded

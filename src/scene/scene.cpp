@@ -452,6 +452,7 @@ void buildCloth(Model& model, const std::vector<ClothSpec>& cloth, const std::st
     piece.wetByContact = c.chen.wetByContact;
     piece.dropsVanish = c.chen.dropsVanish;
     piece.panelOfVertex = c.panelOfVertex;
+    piece.seams = c.seams;
   }
   buildTethers(model);
   buildGarmentPieces(model);  // Chen 2012 springs of the implicit pieces

@@ -31,6 +31,12 @@ using Mesher = CGAL::Delaunay_mesher_no_edge_refinement_2<Cdt, Criteria>;
 
 constexpr double kPi = 3.14159265358979323846;
 
+// the path of a part of the pattern in errors: "<source>.panels[1]", or "<file>: at panels[1]" for a
+// source ending in a space
+std::string at(const std::string& source, const std::string& path) {
+  return source + (!source.empty() && source.back() == ' ' ? "" : ".") + path;
+}
+
 double cross2(const Vec2d& a, const Vec2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 bool segmentsCross(const Vec2d& p, const Vec2d& q, const Vec2d& r, const Vec2d& s) {
@@ -246,11 +252,11 @@ double estimatedPatternVertices(const SewingPattern& pattern, double edgeLength)
 }
 
 SewnGarment sewPattern(const SewingPattern& pattern, double edgeLength, const std::string& source) {
-  if (pattern.panels.empty()) throw Error(fmt::format("{}.panels: expected at least one panel, got none", source));
+  if (pattern.panels.empty()) throw Error(fmt::format("{}: expected at least one panel, got none", at(source, "panels")));
   if (!(edgeLength > 0.0)) throw Error(fmt::format("{}: expected an edge length > 0 m, got {}", source, edgeLength));
   std::set<std::string> names;
   for (size_t i = 0; i < pattern.panels.size(); ++i) {
-    const std::string where = fmt::format("{}.panels[{}]", source, i);
+    const std::string where = at(source, fmt::format("panels[{}]", i));
     checkPanel(pattern.panels[i], where);
     if (!names.insert(pattern.panels[i].name).second)
       throw Error(fmt::format("{}.name: expected a name no other panel has, got \"{}\" again", where,
@@ -260,7 +266,7 @@ SewnGarment sewPattern(const SewingPattern& pattern, double edgeLength, const st
   std::vector<Stretch> stretches;
   for (size_t s = 0; s < pattern.seams.size(); ++s) {
     const PatternSeam& seam = pattern.seams[s];
-    const std::string where = fmt::format("{}.seams[{}]", source, s);
+    const std::string where = at(source, fmt::format("seams[{}]", s));
     checkEdge(pattern, seam.a, where + ".a");
     checkEdge(pattern, seam.b, where + ".b");
     const PatternPanel& pa = pattern.panels[seam.a.panel];
@@ -282,7 +288,7 @@ SewnGarment sewPattern(const SewingPattern& pattern, double edgeLength, const st
   std::vector<int> firstVertex(pattern.panels.size());
   for (size_t i = 0; i < pattern.panels.size(); ++i) {
     const PatternPanel& p = pattern.panels[i];
-    const std::string where = fmt::format("{}.panels[{}]", source, i);
+    const std::string where = at(source, fmt::format("panels[{}]", i));
     const std::vector<Vec2d> ring = buildRing(p, static_cast<int>(i), stretches, edgeLength, where);
     std::vector<Vec2d> flat;
     std::vector<std::array<int, 3>> tris;

@@ -63,7 +63,8 @@ double estimatedPatternVertices(const SewingPattern& pattern, double edgeLength)
 // segment in two seams) and triangulates it: every outline segment is split into pieces of at most
 // edgeLength (a seam's two sides into the same number, at the same arc-length fractions, keeping the
 // corners of both), interior triangles have edges of about edgeLength and angles of at least 20.7
-// degrees. Throws soak::Error "<source>.panels[i]...: expected ..., got ..." on bad input.
+// degrees. Throws soak::Error "<source>.panels[i]...: expected ..., got ..." on bad input (a source
+// ending in a space, "<file>: at ", gives "<file>: at panels[i]...").
 SewnGarment sewPattern(const SewingPattern& pattern, double edgeLength, const std::string& source);
 
 }  // namespace soak
