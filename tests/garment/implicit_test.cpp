@@ -42,7 +42,7 @@ ImplicitStats stepRig(Rig& r, double t, float h, const std::vector<PositionConst
                       const std::vector<float>& saturation = {}) {
   r.poses.resize(r.model.colliders.size());
   for (size_t c = 0; c < r.model.colliders.size(); ++c) r.poses[c] = colliderPose(r.model.colliders[c], t + h);
-  const ImplicitStats s = implicitStep(r.model, r.g, r.params, h, 0.0, r.poses, saturation, constraints, r.p, r.scratch);
+  const ImplicitStats s = implicitStep(r.model, r.g, r.params, h, t, r.poses, saturation, constraints, r.p, r.scratch);
   r.p.x = r.p.xPred;  // the caller's commit
   return s;
 }

@@ -1,0 +1,116 @@
+// "type": "pattern" cloth meshes (scene/pattern_keys.hpp): the shipped T-shirt sews shut on the body,
+// the keys reach the model, and bad patterns are refused naming the file and the place
+#include <soak/error.hpp>
+#include <soak/scene.hpp>
+
+#include "garment/implicit.hpp"
+#include "support/garment_scene.hpp"
+#include "world/garment_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace soak {
+namespace {
+
+using testing::fromString;
+using testing::loadError;
+
+const std::string kTShirtScene = std::string(SOAK_SOURCE_DIR) + "/scenes/garment_tshirt_sewn_dry.json";
+
+// a mannequin in the T-shirt's pose and one implicit piece whose mesh is `mesh` (JSON)
+std::string sceneWith(const std::string& mesh, const std::string& solver = "implicit") {
+  return R"({"solver": {"dt": 0.0166667, "domain": {"min": [-1.5, 0, -1.5], "max": [1.5, 2.5, 1.5]}},
+  "colliders": [{"name": "body", "type": "mannequin", "pose": {"shoulderAbduction": [45, 45]}}],
+  "cloth": [{"name": "shirt", "solver": ")" + solver + R"(", "mesh": )" + mesh + "}]}";
+}
+
+// a tube of two 0.5 x 0.4 m panels around the waist, sewn at both sides
+const std::string kTube = R"({"type": "pattern", "body": "body", "edgeLength": 0.05, "pattern": {
+  "panels": [{"name": "front", "origin": [0, 0.9, 0.2], "outline": [[-0.25, 0], [0.25, 0], [0.25, 0.4], [-0.25, 0.4]]},
+             {"name": "back", "origin": [0, 0.9, -0.2], "yaw": 180,
+              "outline": [[-0.25, 0], [0.25, 0], [0.25, 0.4], [-0.25, 0.4]]}],
+  "seams": [{"a": {"panel": "front", "from": 1, "to": 2}, "b": {"panel": "back", "from": 3, "to": 0}},
+            {"a": {"panel": "front", "from": 3, "to": 0}, "b": {"panel": "back", "from": 1, "to": 2}}]}})";
+
+TEST(PatternScene, KeysReachTheModel) {
+  const Scene s = fromString(sceneWith(kTube), {"cloth.0.garment.seams.closeTime=0.3"});
+  const ClothPiece& piece = s.model.pieces[0];
+  EXPECT_EQ(piece.seams.size(), 2u * 9u);  // 0.4 m sides at 0.05 m: 9 points each
+  ASSERT_EQ(piece.panelOfVertex.size(), size_t(piece.particleCount));
+  EXPECT_FLOAT_EQ(piece.garment.seams.closeTime, 0.3f);
+  EXPECT_FLOAT_EQ(piece.garment.laws.seamStiffness, piece.garment.laws.stretch.a1);  // an edge's, by default
+  ASSERT_TRUE(piece.implicit);
+  EXPECT_EQ(piece.implicit->springs.kindStart[4] - piece.implicit->springs.kindStart[3], 18);
+  const Scene k = fromString(sceneWith(kTube), {"cloth.0.garment.seams.stiffness=500"});
+  EXPECT_FLOAT_EQ(k.model.pieces[0].garment.laws.seamStiffness, 500.0f);
+}
+
+TEST(PatternScene, TheShippedTShirtSewsShutOnTheBody) {
+  Scene s = loadScene(kTShirtScene, {"cloth.0.mesh.edgeLength=0.04"});
+  const Model& m = s.model;
+  const ClothPiece& piece = m.pieces[0];
+  ASSERT_GT(piece.seams.size(), 50u);
+  const auto& x = s.state.particles.x;
+  float widest = 0.0f;
+  for (const auto& [a, b] : piece.seams) widest = std::max(widest, (x[a] - x[b]).norm());
+  EXPECT_GT(widest, 0.25f);  // the panels start 0.28 m apart
+  StepStats total;
+  testing::run(m, s.state, 60, &total);  // 1 s: sewn by 0.5 s, then 0.5 s under gravity
+  float gap = 0.0f;
+  for (const auto& [a, b] : piece.seams) gap = std::max(gap, (x[a] - x[b]).norm());
+  EXPECT_LT(gap, 0.001f);  // measured 0.15 mm
+  const float thickness = piece.material.thickness;
+  float deepest = 1e30f;
+  double lowest = 1e30;
+  for (int i = 0; i < m.numCloth; ++i) {
+    deepest = std::min(deepest, bodyDistance(m.colliders, s.state.time, x[size_t(i)], nullptr));
+    lowest = std::min(lowest, double(x[size_t(i)].y()));
+  }
+  EXPECT_GT(deepest, 0.5f * thickness - 5e-4f);  // every vertex outside the contact margin (measured at it)
+  EXPECT_GT(total.garment.contacts, 0u);  // it rests on the body
+  EXPECT_GT(lowest, 0.72);                // and stays on: the hem, sewn at 0.80 m, settles at 0.75 m
+  EXPECT_EQ(total.garment.unconverged, 0u);
+}
+
+std::string writePatternFile(const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(PatternSceneErrors, BadPatternsAreRefusedNamingTheFileAndThePlace) {
+  // a clockwise panel inline: the scene's path
+  std::string cw = kTube;
+  cw.replace(cw.find("[[-0.25, 0], [0.25, 0], [0.25, 0.4], [-0.25, 0.4]]"), 50,
+             "[[-0.25, 0.4], [0.25, 0.4], [0.25, 0], [-0.25, 0]]");
+  EXPECT_HAS(loadError(sceneWith(cw)),
+             "garment.json: at cloth[0].mesh.pattern.panels[0].outline: expected counter-clockwise corners");
+  // a seam naming a panel the pattern lacks, in a pattern file: that file's path
+  std::string pattern = kTube.substr(kTube.find("\"pattern\": ") + 11);
+  pattern.pop_back();  // the mesh object's closing brace
+  std::string badSeam = pattern;
+  badSeam.replace(badSeam.find("\"panel\": \"back\""), 15, "\"panel\": \"bak\"");
+  const std::string file = writePatternFile("bad_seam.json", badSeam);
+  EXPECT_HAS(loadError(sceneWith(R"({"type": "pattern", "path": ")" + file + R"("})")),
+             file + ": at seams[0].b.panel: expected the name of a panel (front, back), got \"bak\"");
+  EXPECT_HAS(loadError(sceneWith(R"({"type": "pattern", "path": "/nonexistent/p.json"})")),
+             "at cloth[0].mesh.path: expected a readable pattern file");
+  const std::string good = writePatternFile("tube.json", pattern);
+  EXPECT_HAS(loadError(sceneWith(R"({"type": "pattern", "path": ")" + good + R"(", "pattern": {}})")),
+             "expected either \"pattern\" (the pattern inline) or \"path\" (a pattern file), got both");
+  EXPECT_HAS(loadError(sceneWith(R"({"type": "pattern", "path": ")" + good + R"("})", "pbd")),
+             "expected \"solver\": \"implicit\" on the piece");
+  EXPECT_HAS(loadError(sceneWith(R"({"type": "pattern", "path": ")" + good + R"(", "resolution": [3, 3]})")),
+             "'resolution' is not a key of a pattern mesh");
+  // a fine edge length is refused from the panels' area, before any meshing
+  EXPECT_HAS(loadError(sceneWith(R"({"type": "pattern", "path": ")" + good + R"(", "edgeLength": 0.002})"),
+                       {"solver.maxParticles=100000"}),
+             "at cloth[0].mesh.edgeLength: expected at most 100000 vertices");
+  EXPECT_TRUE(loadError(sceneWith(R"({"type": "pattern", "path": ")" + good + R"("})")).empty());
+}
+
+}  // namespace
+}  // namespace soak
