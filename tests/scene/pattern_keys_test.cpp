@@ -18,7 +18,7 @@ namespace {
 using testing::fromString;
 using testing::loadError;
 
-const std::string kTShirtScene = std::string(SOAK_SOURCE_DIR) + "/scenes/garment_tshirt_sewn_dry.json";
+const std::string kTShirtScene = std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_dry.json";
 
 // a mannequin in the T-shirt's pose and one implicit piece whose mesh is `mesh` (JSON)
 std::string sceneWith(const std::string& mesh, const std::string& solver = "implicit") {
