@@ -1,4 +1,4 @@
-// "type": "pattern" cloth meshes (scene/pattern_keys.hpp): the shipped T-shirt sews shut on the body,
+// "type": "pattern" cloth meshes (scene/pattern_keys.hpp): the shipped garments sew shut on the body,
 // the keys reach the model, and bad patterns are refused naming the file and the place
 #include <soak/error.hpp>
 #include <soak/scene.hpp>
@@ -17,8 +17,6 @@ namespace {
 
 using testing::fromString;
 using testing::loadError;
-
-const std::string kTShirtScene = std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_dry.json";
 
 // a mannequin in the T-shirt's pose and one implicit piece whose mesh is `mesh` (JSON)
 std::string sceneWith(const std::string& mesh, const std::string& solver = "implicit") {
@@ -48,11 +46,21 @@ TEST(PatternScene, KeysReachTheModel) {
   EXPECT_FLOAT_EQ(k.model.pieces[0].garment.laws.seamStiffness, 500.0f);
 }
 
-TEST(PatternScene, TheShippedTShirtSewsShutOnTheBody) {
-  Scene s = loadScene(kTShirtScene, {"cloth.0.mesh.edgeLength=0.04"});
+// the shipped garments: their seams close, no vertex ends inside the body, and the garment stays on
+struct ShippedGarment {
+  const char* scene;
+  double lowest;  // m, the lowest point after 1 s stays above this (measured 3 to 4 cm above; falling off
+                  // would take it 1 m lower)
+};
+
+class ShippedGarments : public ::testing::TestWithParam<ShippedGarment> {};
+
+TEST_P(ShippedGarments, SewShutOnTheBodyAndStayOn) {
+  Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/" + GetParam().scene,
+                      {"cloth.0.mesh.edgeLength=0.04", "emitters=[]"});
   const Model& m = s.model;
   const ClothPiece& piece = m.pieces[0];
-  ASSERT_GT(piece.seams.size(), 50u);
+  ASSERT_GT(piece.seams.size(), 20u);
   const auto& x = s.state.particles.x;
   float widest = 0.0f;
   for (const auto& [a, b] : piece.seams) widest = std::max(widest, (x[a] - x[b]).norm());
@@ -61,7 +69,7 @@ TEST(PatternScene, TheShippedTShirtSewsShutOnTheBody) {
   testing::run(m, s.state, 60, &total);  // 1 s: sewn by 0.5 s, then 0.5 s under gravity
   float gap = 0.0f;
   for (const auto& [a, b] : piece.seams) gap = std::max(gap, (x[a] - x[b]).norm());
-  EXPECT_LT(gap, 0.001f);  // measured 0.15 mm
+  EXPECT_LT(gap, 0.001f);  // measured 0.06 to 0.36 mm
   const float thickness = piece.material.thickness;
   float deepest = 1e30f;
   double lowest = 1e30;
@@ -70,9 +78,23 @@ TEST(PatternScene, TheShippedTShirtSewsShutOnTheBody) {
     lowest = std::min(lowest, double(x[size_t(i)].y()));
   }
   EXPECT_GT(deepest, 0.5f * thickness - 5e-4f);  // every vertex outside the contact margin (measured at it)
-  EXPECT_GT(total.garment.contacts, 0u);  // it rests on the body
-  EXPECT_GT(lowest, 0.72);                // and stays on: the hem, sewn at 0.80 m, settles at 0.75 m
+  EXPECT_GT(total.garment.contacts, 0u);         // it rests on the body
+  EXPECT_GT(lowest, GetParam().lowest);
   EXPECT_EQ(total.garment.unconverged, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedGarments,
+                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72},
+                                           ShippedGarment{"garment_dress_rain.json", 0.45},
+                                           ShippedGarment{"garment_skirt.json", 0.44}));
+
+// point 2 of issue 23: the shipped patterns at their scenes' edge length have 5k to 20k vertices
+TEST(PatternScene, ShippedGarmentsHaveFiveToTwentyThousandVertices) {
+  for (const char* scene : {"chen_fig9_garment_rain_dry.json", "garment_dress_rain.json", "garment_skirt.json"}) {
+    const Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/" + scene);
+    EXPECT_GE(s.model.numCloth, 5000) << scene;
+    EXPECT_LE(s.model.numCloth, 20000) << scene;
+  }
 }
 
 std::string writePatternFile(const std::string& name, const std::string& text) {
