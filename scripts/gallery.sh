@@ -7,7 +7,7 @@
 #   scripts/gallery.sh [--work DIR] [--fresh] [STILL...]
 #
 # STILL: any of the names below (default: all), e.g. `scripts/gallery.sh fig4 fig5 fig9`.
-#   fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 sweep
+#   fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments sweep
 # --work DIR: where the runs and renders go (default /tmp/soak-gallery). A run already there with the
 #   frames a still needs is reused (its run.json must say status ok and at least those frames); pass
 #   --fresh to run every scene again.
@@ -24,7 +24,7 @@ threads="${THREADS:-2}"
 work=/tmp/soak-gallery
 fresh=0
 stills=()
-all=(fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 sweep)
+all=(fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments sweep)
 while [ $# -gt 0 ]; do
   case "$1" in
     --work) work="$2"; shift 2 ;;
@@ -149,6 +149,10 @@ still_chen_fig8() {
 still_chen_fig9() {
   still chen_fig9_garment_rain_dry 300 --particles
   still chen_fig9_garment_rain_wet 300 --particles
+}
+still_garments() {
+  still garment_dress_rain 300 --particles
+  still garment_skirt 90
 }
 # the contact sheet of sweeps/fig5c_wicking.json (docs/sweeps.md; its complete variants are reused)
 still_sweep() {
