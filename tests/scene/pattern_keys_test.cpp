@@ -5,6 +5,7 @@
 
 #include "garment/implicit.hpp"
 #include "support/garment_scene.hpp"
+#include "support/mesh_crossings.hpp"
 #include "world/garment_mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -51,6 +52,7 @@ struct ShippedGarment {
   const char* scene;
   double lowest;  // m, the lowest point after 1 s stays above this (measured 3 to 4 cm above; falling off
                   // would take it 1 m lower)
+  size_t crossings;  // triangle pairs through each other after 1 s, at most
 };
 
 class ShippedGarments : public ::testing::TestWithParam<ShippedGarment> {};
@@ -81,12 +83,33 @@ TEST_P(ShippedGarments, SewShutOnTheBodyAndStayOn) {
   EXPECT_GT(total.garment.contacts, 0u);         // it rests on the body
   EXPECT_GT(lowest, GetParam().lowest);
   EXPECT_EQ(total.garment.unconverged, 0u);
+  const std::vector<Vec3> cloth(x.begin(), x.begin() + m.numCloth);
+  EXPECT_LE(testing::countCrossingTriangles(cloth, m.triangles, piece.seams), GetParam().crossings);
 }
 
 INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedGarments,
-                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72},
-                                           ShippedGarment{"garment_dress_rain.json", 0.45},
-                                           ShippedGarment{"garment_skirt.json", 0.44}));
+                         // the T-shirt's underarm seams fold through themselves (14 pairs of its 1,270
+                         // triangles, with or without wrinkles): the implicit solver has no
+                         // self-collision yet (issue 23 point 3); the dress and the skirt have none
+                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72, 20},
+                                           ShippedGarment{"garment_dress_rain.json", 0.45, 0},
+                                           ShippedGarment{"garment_skirt.json", 0.44, 0}));
+
+// the counter the garment test uses: a triangle pierced by another counts, one touching it through a
+// shared or seam-joined vertex does not
+TEST(PatternScene, CrossingCounterSeesTrianglesThroughEachOther) {
+  std::vector<Vec3> x = {Vec3(0, 0, 0),     Vec3(1, 0, 0),      Vec3(0, 1, 0),  // in z = 0
+                         Vec3(0.2f, 0.2f, -0.5f), Vec3(0.3f, 0.2f, 0.5f), Vec3(0.2f, 0.4f, 0.5f)};  // through it
+  const std::vector<std::array<int, 3>> tris = {{0, 1, 2}, {3, 4, 5}};
+  EXPECT_EQ(testing::countCrossingTriangles(x, tris), 1u);
+  EXPECT_EQ(testing::countCrossingTriangles(x, tris, {{{0, 3}}}), 0u);  // joined by a seam
+  x[3].z() = 0.1f;  // lifted above the plane: clear
+  EXPECT_EQ(testing::countCrossingTriangles(x, tris), 0u);
+  x.push_back(Vec3(0.3f, 0.3f, -0.5f));  // 6 and 7: an edge through the first triangle
+  x.push_back(Vec3(0.3f, 0.3f, 0.5f));
+  EXPECT_EQ(testing::countCrossingTriangles(x, {{0, 1, 2}, {3, 6, 7}}), 1u);
+  EXPECT_EQ(testing::countCrossingTriangles(x, {{0, 1, 2}, {0, 6, 7}}), 0u);  // sharing a vertex: not compared
+}
 
 // point 2 of issue 23: the shipped patterns at their scenes' edge length have 5k to 20k vertices
 TEST(PatternScene, ShippedGarmentsHaveFiveToTwentyThousandVertices) {
