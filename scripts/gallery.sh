@@ -50,10 +50,13 @@ export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}"
 font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
 log() { printf '%s gallery: %s\n' "$(date +%T)" "$*" >&2; }
 
-# run SCENE FRAMES: simulates scenes/SCENE.json up to frame FRAMES into $work/SCENE (reused when done)
+# run SCENE FRAMES: simulates scenes/SCENE.json up to frame FRAMES into $work/SCENE (reused when done
+# and newer than the scene file and every pattern file, which a scene may sew)
 run() {
   local scene="$1" frames="$2" dir="$work/$1"
-  if [ "$fresh" = 0 ] && [ -f "$dir/run.json" ] && python3 - "$dir/run.json" "$frames" <<'EOF'
+  if [ "$fresh" = 0 ] && [ -f "$dir/run.json" ] &&
+    [ -z "$(find "scenes/$scene.json" patterns -newer "$dir/run.json" -print -quit)" ] &&
+    python3 - "$dir/run.json" "$frames" <<'EOF'
 import json, sys
 r = json.load(open(sys.argv[1]))
 sys.exit(0 if r.get("status") == "ok" and r.get("frames", -1) >= int(sys.argv[2]) else 1)

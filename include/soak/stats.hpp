@@ -42,12 +42,13 @@ struct GarmentStats {
   uint64_t breakdowns = 0;      // solves whose system was not positive definite
   uint64_t contacts = 0;        // vertex-collider contacts
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)
+  uint64_t selfContacts = 0;    // vertex-triangle pushes of an implicit piece's self-collision
   uint64_t disturbances = 0;    // wrinkle constraints applied (section 3.5)
   uint64_t dropsTaken = 0;      // water particles that wetted a piece and vanished into it
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; contacts += o.contacts; edgeContacts += o.edgeContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; contacts += o.contacts; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     return *this;
   }
 };

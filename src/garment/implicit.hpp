@@ -21,6 +21,7 @@
 
 #include "garment/block_cg.hpp"
 #include "garment/saturation_mass.hpp"
+#include "garment/self_collision.hpp"
 #include "garment/springs.hpp"
 #include "garment/wet_friction.hpp"
 #include "garment/wrinkles.hpp"
@@ -45,6 +46,8 @@ struct GarmentPiece {
   // in springs.vertexSpring order
   std::vector<int> rowStart, col;
   std::vector<std::vector<int>> subdomains;  // piece-local vertex sets for the wrinkle model
+  std::vector<std::array<int, 3>> triangles;  // piece-local
+  std::vector<int> seamGroup;                 // per vertex: the lowest vertex it is seamed to (itself if none)
 };
 
 // builds the garment data of model.pieces[piece]; subdomains are connected patches of
@@ -61,6 +64,8 @@ struct ImplicitScratch {
   std::vector<uint8_t> constrained;
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
+  std::vector<float> invMass;      // self-collision: 1/m, 0 for pinned and disturbed vertices
+  SelfCollisionScratch self;
 };
 
 struct ImplicitStats {
@@ -71,6 +76,7 @@ struct ImplicitStats {
   int constrainedVertices = 0;  // pinned + disturbed
   int contacts = 0;             // vertices pushed out of a collider
   int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider
+  int selfContacts = 0;         // vertex-triangle pushes of the self-collision (material.selfCollision)
   int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)
   float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
 };

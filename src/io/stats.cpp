@@ -87,6 +87,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"breakdowns", g.breakdowns},
                     {"contacts", g.contacts},
                     {"edgeContacts", g.edgeContacts},
+                    {"selfContacts", g.selfContacts},
                     {"disturbances", g.disturbances},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},

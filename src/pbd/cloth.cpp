@@ -266,7 +266,8 @@ void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& n
     const int piece = clothPiece(p.phase[i]);
     if (piece < 0 || piece >= static_cast<int>(model.pieces.size())) return;
     const ClothMaterial& mat = model.pieces[piece].material;
-    if (!mat.selfCollision || w[i] == 0.0f) return;
+    // an implicit piece has its own (garment/self_collision.hpp)
+    if (!mat.selfCollision || w[i] == 0.0f || model.pieces[piece].solver != ClothSolver::Pbd) return;
     const float thickness = mat.thickness;
     const auto ringBegin = model.vertexNeighbors.begin() + model.vertexNeighborStart[i];
     const auto ringEnd = model.vertexNeighbors.begin() + model.vertexNeighborStart[i + 1];

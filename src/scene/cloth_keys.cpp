@@ -27,10 +27,6 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
         r.log().error(r.pathOf(key), fmt::format("expected no {} on a piece with \"solver\": \"implicit\" (a PBD "
                                                  "key; set the garment section instead, docs/scene-format.md)",
                                                  key));
-    if (const Json* sc = r.get("selfCollision"); sc && sc->is_boolean() && sc->get<bool>())
-      r.log().error(r.pathOf("selfCollision"),
-                    "expected false on a piece with \"solver\": \"implicit\" (the implicit solver has no "
-                    "self-collision), got true");
   }
   if (r.has("particleMass") && r.has("arealDensity"))
     r.log().error(r.pathOf("arealDensity"), "expected either particleMass (kg a particle) or arealDensity (kg/m^2), "
@@ -44,7 +40,7 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   m.damping = r.number("damping", d.damping, Range::nonNegative());
   m.thickness = r.number("thickness", d.thickness, Range::positive());
   readFriction(r, d.friction, m.friction, m.staticFriction);
-  m.selfCollision = r.boolean("selfCollision", d.selfCollision) && solver == ClothSolver::Pbd;
+  m.selfCollision = r.boolean("selfCollision", d.selfCollision);
   m.tetherSlack = r.number("tetherSlack", d.tetherSlack, Range::nonNegative());
   r.finish();
   return m;

@@ -51,7 +51,7 @@ TEST(GarmentScene, KeysReachTheModel) {
   EXPECT_FLOAT_EQ(p.garment.friction.peak, 0.7f);
   EXPECT_TRUE(p.garment.wrinkles.enabled);              // a present section is on
   EXPECT_EQ(p.garment.wrinkles.interval, 5);
-  EXPECT_FALSE(p.material.selfCollision);
+  EXPECT_TRUE(p.material.selfCollision);  // the implicit solver's own (garment/self_collision.hpp)
   // the garment's panels are the wrinkle subdomains; no PBD constraints or tethers for it
   EXPECT_EQ(p.panelOfVertex.size(), size_t(p.particleCount));
   EXPECT_TRUE(m.stretch.ids.empty());
@@ -104,8 +104,6 @@ TEST(GarmentSceneErrors, KeysOfTheOtherSolverAreRefused) {
   EXPECT_HAS(loadError(kSheet, {"cloth.0.material.stretchCompliance=0.1"}),
              "at cloth[0].material.stretchCompliance: expected no stretchCompliance on a piece with \"solver\": "
              "\"implicit\"");
-  EXPECT_HAS(loadError(kSheet, {"cloth.0.material.selfCollision=true"}),
-             "at cloth[0].material.selfCollision: expected false");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.material.tetherSlack=0.1"}),
              "at cloth[0].material.tetherSlack: expected no tetherSlack on a piece with \"solver\": \"implicit\"");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.solver=pbd"}), "at cloth[0].garment: expected no garment section on a piece "

@@ -1,0 +1,163 @@
+// vertex-triangle self-collision of implicit garments (self_collision.hpp)
+#include "garment/self_collision.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
+                           const std::array<float, 4>& w, float d) {
+  const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
+  const float area2 = n1raw.norm();
+  if (!(area2 > 1e-12f)) return false;
+  const Vec3 n1 = n1raw / area2;
+  const float dist1 = (x1[0] - x1[1]).dot(n1);
+  const Vec3 n0raw = (x0[2] - x0[1]).cross(x0[3] - x0[1]);
+  const float dist0 = n0raw.squaredNorm() > 1e-24f ? (x0[0] - x0[1]).dot(n0raw.normalized()) : dist1;
+  // the side the vertex started on; a vertex that started in the plane keeps the side it ends on
+  const float side = std::abs(dist0) > 1e-7f ? (dist0 > 0.0f ? 1.0f : -1.0f) : (dist1 >= 0.0f ? 1.0f : -1.0f);
+  if (side * dist1 >= d) return false;
+  // barycentric coordinates of the vertex's projection on the triangle's plane at the end
+  const Vec3 q = x1[0] - dist1 * n1;
+  std::array<float, 4> b{};
+  for (int k = 1; k <= 3; ++k) {
+    const Vec3& u = x1[k % 3 + 1];
+    const Vec3& t = x1[(k + 1) % 3 + 1];
+    b[k] = (u - q).cross(t - q).dot(n1) / area2;
+    if (b[k] < 0.0f) return false;  // outside: the neighbouring triangle's business
+  }
+  const float denom = w[0] + b[1] * b[1] * w[1] + b[2] * b[2] * w[2] + b[3] * b[3] * w[3];
+  if (!(denom > 0.0f)) return false;
+  const float push = (side * d - dist1) / denom;  // along n1, shared by inverse mass and weight
+  x1[0] += w[0] * push * n1;
+  for (int k = 1; k <= 3; ++k) x1[k] -= b[k] * w[k] * push * n1;
+  Vec3 rel = v[0];
+  for (int k = 1; k <= 3; ++k) rel -= b[k] * v[k];
+  const float approach = side * rel.dot(n1);
+  if (approach < 0.0f) {  // inelastic: the velocity towards each other is removed
+    const float j = -approach / denom;
+    v[0] += w[0] * j * side * n1;
+    for (int k = 1; k <= 3; ++k) v[k] -= b[k] * w[k] * j * side * n1;
+  }
+  return true;
+}
+
+namespace {
+
+constexpr uint32_t kBucketBits = 16;
+constexpr int kPasses = 3;  // Gauss-Seidel passes: a push can undo an earlier one nearby
+
+uint32_t bucketOf(int64_t i, int64_t j, int64_t k) {
+  const uint64_t h = uint64_t(i) * 73856093ULL ^ uint64_t(j) * 19349663ULL ^ uint64_t(k) * 83492791ULL;
+  return static_cast<uint32_t>(h & ((1u << kBucketBits) - 1));
+}
+
+// hashes every primitive (triangle or edge) into the cells its end-of-step box, padded by `pad`,
+// overlaps (counting sort)
+template <size_t N>
+void hashPrimitives(const std::vector<std::array<int, N>>& tris, const Vec3* x1, float cell, float pad,
+                    SelfCollisionScratch& s) {
+  const size_t nt = tris.size();
+  s.cellLo.resize(nt);
+  s.cellHi.resize(nt);
+  s.bucketStart.assign((1u << kBucketBits) + 1, 0);
+  for (size_t t = 0; t < nt; ++t) {
+    Vec3 lo = x1[tris[t][0]], hi = lo;
+    for (size_t k = 1; k < N; ++k) {
+      lo = lo.cwiseMin(x1[tris[t][k]]);
+      hi = hi.cwiseMax(x1[tris[t][k]]);
+    }
+    for (int a = 0; a < 3; ++a) {
+      s.cellLo[t][a] = static_cast<int>(std::floor((lo[a] - pad) / cell));
+      s.cellHi[t][a] = static_cast<int>(std::floor((hi[a] + pad) / cell));
+    }
+  }
+  const auto forCells = [&](size_t t, auto&& f) {
+    for (int i = s.cellLo[t][0]; i <= s.cellHi[t][0]; ++i)
+      for (int j = s.cellLo[t][1]; j <= s.cellHi[t][1]; ++j)
+        for (int k = s.cellLo[t][2]; k <= s.cellHi[t][2]; ++k) f(bucketOf(i, j, k));
+  };
+  for (size_t t = 0; t < nt; ++t) forCells(t, [&](uint32_t b) { ++s.bucketStart[b + 1]; });
+  for (size_t b = 0; b + 1 < s.bucketStart.size(); ++b) s.bucketStart[b + 1] += s.bucketStart[b];
+  s.entry.resize(s.bucketStart.back());
+  std::vector<uint32_t> fill(s.bucketStart.begin(), s.bucketStart.end() - 1);
+  for (size_t t = 0; t < nt; ++t) forCells(t, [&](uint32_t b) { s.entry[fill[b]++] = static_cast<int>(t); });
+}
+
+}  // namespace
+
+namespace {
+
+// the four particles of one test (ids local to the piece), gathered and written back
+struct Four {
+  std::array<int, 4> id;
+  std::array<Vec3, 4> x0, x1, v;
+  std::array<float, 4> w;
+  Four(const std::array<int, 4>& ids, const Vec3* x0s, const Vec3* x1s, const Vec3* vs, const std::vector<float>& inv)
+      : id(ids) {
+    for (int k = 0; k < 4; ++k) {
+      x0[k] = x0s[id[k]];
+      x1[k] = x1s[id[k]];
+      v[k] = vs[id[k]];
+      w[k] = inv[id[k]];
+    }
+  }
+  void store(Vec3* x1s, Vec3* vs, std::vector<uint8_t>& moved) const {
+    for (int k = 0; k < 4; ++k) {
+      x1s[id[k]] = x1[k];
+      vs[id[k]] = v[k];
+      moved[id[k]] = 1;
+    }
+  }
+};
+
+// calls f(primitive) for every primitive hashed into the cell of point q (and whose box holds it)
+template <typename F>
+void forPrimitivesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F&& f) {
+  const int ci = static_cast<int>(std::floor(q.x() / cell)), cj = static_cast<int>(std::floor(q.y() / cell)),
+            ck = static_cast<int>(std::floor(q.z() / cell));
+  const uint32_t b = bucketOf(ci, cj, ck);
+  for (uint32_t e = s.bucketStart[b]; e < s.bucketStart[b + 1]; ++e) {
+    const int t = s.entry[e];
+    const auto& lo = s.cellLo[t];
+    const auto& hi = s.cellHi[t];
+    if (ci < lo[0] || ci > hi[0] || cj < lo[1] || cj > hi[1] || ck < lo[2] || ck > hi[2]) continue;
+    f(t);
+  }
+}
+
+}  // namespace
+
+int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int first, int count, const std::vector<float>& invMass,
+                float thickness, Particles& p, SelfCollisionScratch& s) {
+  if (tris.empty() || count == 0) return 0;
+  const Vec3* x0 = p.x.data() + first;
+  Vec3* x1 = p.xPred.data() + first;
+  Vec3* vel = p.v.data() + first;
+  float move = 0.0f, edge = 0.0f;
+  for (int i = 0; i < count; ++i) move = std::max(move, (x1[i] - x0[i]).norm());
+  for (const auto& t : tris) edge += (x1[t[1]] - x1[t[0]]).norm();
+  s.moved.assign(static_cast<size_t>(count), 0);
+  int pushes = 0;
+  // a vertex near a triangle lies in its box padded by the thickness (and the step's largest motion,
+  // for the pushes before it)
+  const float pad = thickness + move;
+  const float cell = std::max(edge / float(tris.size()), 2.0f * pad);
+  hashPrimitives(tris, x1, cell, pad, s);
+  for (int pass = 0; pass < kPasses; ++pass)
+  for (int i = 0; i < count; ++i) {
+    if (invMass[i] == 0.0f) continue;
+    forPrimitivesAt(x1[i], cell, s, [&](int t) {
+      const auto& tri = tris[t];
+      if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
+      Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
+      if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) return;
+      f.store(x1, vel, s.moved);
+      ++pushes;
+    });
+  }
+  return pushes;
+}
+
+}  // namespace soak

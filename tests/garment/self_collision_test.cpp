@@ -1,0 +1,62 @@
+// vertex-triangle self-collision of implicit garments (garment/self_collision.hpp)
+#include "garment/self_collision.hpp"
+
+#include <gtest/gtest.h>
+
+namespace soak {
+namespace {
+
+// the triangle (0,0,0), (1,0,0), (0,1,0) in z = 0 and a vertex above its point (0.25, 0.25)
+std::array<Vec3, 4> startAbove(float z) { return {Vec3(0.25f, 0.25f, z), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}; }
+
+TEST(GarmentSelfCollision, AVertexThatPassedThroughIsPutBackOnItsSide) {
+  const std::array<Vec3, 4> x0 = startAbove(0.02f);
+  std::array<Vec3, 4> x1 = startAbove(-0.01f);  // went through during the step
+  std::array<Vec3, 4> v = {Vec3(0, 0, -3), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  const std::array<float, 4> w = {1.0f, 1.0f, 1.0f, 1.0f};
+  Vec3 momentum = Vec3::Zero(), moment0 = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) moment0 += v[k] / w[k];
+  ASSERT_TRUE(pushVertexOffTriangle(x0, x1, v, w, 0.008f));
+  // the vertex is a thickness above the triangle, which moved down under the push
+  const float above = x1[0].z() - (0.5f * x1[1].z() + 0.25f * x1[2].z() + 0.25f * x1[3].z());
+  EXPECT_NEAR(above, 0.008f, 1e-6f);
+  EXPECT_LT(x1[1].z(), 0.0f);
+  for (int k = 0; k < 4; ++k) momentum += v[k] / w[k];
+  EXPECT_NEAR((momentum - moment0).norm(), 0.0f, 1e-5f);  // the impulse is shared, not created
+  // the approach is removed: the vertex no longer moves towards the triangle
+  EXPECT_GE(v[0].z() - (0.5f * v[1].z() + 0.25f * v[2].z() + 0.25f * v[3].z()), -1e-5f);
+}
+
+TEST(GarmentSelfCollision, ClearVerticesAndPinnedPairsAreLeftAlone) {
+  const std::array<float, 4> w = {1.0f, 1.0f, 1.0f, 1.0f};
+  std::array<Vec3, 4> v{};
+  std::array<Vec3, 4> far = startAbove(0.02f);
+  EXPECT_FALSE(pushVertexOffTriangle(startAbove(0.02f), far, v, w, 0.008f));  // farther than the thickness
+  std::array<Vec3, 4> beside = {Vec3(2, 2, 0.001f), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  EXPECT_FALSE(pushVertexOffTriangle(beside, beside, v, w, 0.008f));  // projects outside the triangle
+  std::array<Vec3, 4> near = startAbove(0.002f);
+  EXPECT_FALSE(pushVertexOffTriangle(startAbove(0.002f), near, v, {0, 0, 0, 0}, 0.008f));  // nothing may move
+  std::array<Vec3, 4> below = startAbove(-0.002f);  // below stays below
+  ASSERT_TRUE(pushVertexOffTriangle(startAbove(-0.002f), below, v, w, 0.008f));
+  EXPECT_LT(below[0].z(), below[1].z());
+}
+
+TEST(GarmentSelfCollision, ASheetDroppedOnAnotherStaysOnIt) {
+  // two 2 x 2 quads of the same piece: the upper one's vertices fall through the lower one's plane
+  Particles p;
+  const std::vector<Vec3> lower = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)};
+  for (const Vec3& x : lower) p.add(1, 0, 1.0f, 0.04f, x, Vec3::Zero());
+  for (const Vec3& x : lower) p.add(1, 0, 1.0f, 0.04f, x + Vec3(0.1f, 0.2f, 0.02f), Vec3::Zero());
+  p.xPred = p.x;
+  for (int i = 4; i < 8; ++i) p.xPred[i].z() = -0.005f;
+  const std::vector<std::array<int, 3>> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
+  const std::vector<int> group = {0, 1, 2, 3, 4, 5, 6, 7};
+  const std::vector<float> inv(8, 1.0f);
+  SelfCollisionScratch s;
+  EXPECT_GT(selfCollide(tris, group, 0, 8, inv, 0.008f, p, s), 0);
+  for (int i = 4; i < 8; ++i)  // every upper vertex over the lower sheet is back above it
+    if (p.xPred[i].x() < 1.0f && p.xPred[i].y() < 1.0f) EXPECT_GT(p.xPred[i].z(), 0.0f) << i;
+}
+
+}  // namespace
+}  // namespace soak
