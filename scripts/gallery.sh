@@ -9,8 +9,8 @@
 # STILL: any of the names below (default: all), e.g. `scripts/gallery.sh fig4 fig5 fig9`.
 #   fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments sweep
 # --work DIR: where the runs and renders go (default /tmp/soak-gallery). A run already there with the
-#   frames a still needs is reused (its run.json must say status ok and at least those frames); pass
-#   --fresh to run every scene again.
+#   frames a still needs is reused (its run.json must say status ok and at least those frames, and be
+#   newer than the scene file and every pattern file); pass --fresh to run every scene again.
 # Environment: SOAK (default build/soak), THREADS (default 2); OMP_WAIT_POLICY defaults to PASSIVE.
 #
 # Needs povray and ffmpeg (scripts/setup.sh installs them). Times on 2 shared cores are in
