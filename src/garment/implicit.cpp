@@ -31,6 +31,8 @@ void checkGarmentParams(const GarmentParams& p, const std::string& where) {
   }
   require(p.laws.strainLimit > 0.0f && p.laws.strainLimit < 1.0f, where, "strainLimit", "a number in (0, 1)",
           p.laws.strainLimit);
+  require(p.laws.seamStiffness > 0.0f, where, "seams.stiffness", "a number > 0 (N/m)", p.laws.seamStiffness);
+  require(p.seams.closeTime >= 0.0f, where, "seams.closeTime", "a number >= 0 (s)", p.seams.closeTime);
   require(p.build.bendStraightness >= 0.0f && p.build.bendStraightness <= 1.0f, where, "bendStraightness",
           "a number in [0, 1]", p.build.bendStraightness);
   require(p.saturation.delta >= 0.0f, where, "saturation.delta", "a number >= 0", p.saturation.delta);
@@ -311,11 +313,12 @@ int selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vect
   return pushes;
 }
 
-}  // namespace
-
+// the share of its starting gap a seam's rest length still has at `time`
 float seamOpenFraction(const SeamParams& seams, double time) {
   return seams.closeTime > 0.0f ? static_cast<float>(std::max(0.0, 1.0 - time / seams.closeTime)) : 0.0f;
 }
+
+}  // namespace
 
 ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h, double time,
                            const std::vector<ColliderPose>& poses, std::span<const float> saturation,

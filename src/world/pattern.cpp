@@ -121,7 +121,8 @@ std::vector<double> seamFractions(const Polyline& a, const Polyline& b, bool rev
   std::stable_sort(cand.begin(), cand.end(), [](const auto& x, const auto& y) { return x.second < y.second; });
   const double tol = 0.25 / n;
   std::vector<double> kept = {0.0, 1.0};
-  for (const auto& [f, rank] : cand) {
+  for (const auto& c : cand) {
+    const double f = c.first;
     const bool near = std::any_of(kept.begin(), kept.end(), [&](double g) { return std::abs(g - f) < tol; });
     if (!near) kept.push_back(f);
   }

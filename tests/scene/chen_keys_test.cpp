@@ -51,7 +51,7 @@ TEST(GarmentScene, KeysReachTheModel) {
   EXPECT_FLOAT_EQ(p.garment.friction.peak, 0.7f);
   EXPECT_TRUE(p.garment.wrinkles.enabled);              // a present section is on
   EXPECT_EQ(p.garment.wrinkles.interval, 5);
-  EXPECT_TRUE(p.material.selfCollision);  // the implicit solver's own (garment/self_collision.hpp)
+  EXPECT_FALSE(p.material.selfCollision);  // off by default on an implicit piece
   // the garment's panels are the wrinkle subdomains; no PBD constraints or tethers for it
   EXPECT_EQ(p.panelOfVertex.size(), size_t(p.particleCount));
   EXPECT_TRUE(m.stretch.ids.empty());
