@@ -53,18 +53,16 @@ uint32_t bucketOf(int64_t i, int64_t j, int64_t k) {
   return static_cast<uint32_t>(h & ((1u << kBucketBits) - 1));
 }
 
-// hashes every primitive (triangle or edge) into the cells its end-of-step box, padded by `pad`,
-// overlaps (counting sort)
-template <size_t N>
-void hashPrimitives(const std::vector<std::array<int, N>>& tris, const Vec3* x1, float cell, float pad,
-                    SelfCollisionScratch& s) {
+// hashes every triangle into the cells its end-of-step box, padded by `pad`, overlaps (counting sort)
+void hashTriangles(const std::vector<std::array<int, 3>>& tris, const Vec3* x1, float cell, float pad,
+                   SelfCollisionScratch& s) {
   const size_t nt = tris.size();
   s.cellLo.resize(nt);
   s.cellHi.resize(nt);
   s.bucketStart.assign((1u << kBucketBits) + 1, 0);
   for (size_t t = 0; t < nt; ++t) {
     Vec3 lo = x1[tris[t][0]], hi = lo;
-    for (size_t k = 1; k < N; ++k) {
+    for (int k = 1; k < 3; ++k) {
       lo = lo.cwiseMin(x1[tris[t][k]]);
       hi = hi.cwiseMax(x1[tris[t][k]]);
     }
@@ -84,10 +82,6 @@ void hashPrimitives(const std::vector<std::array<int, N>>& tris, const Vec3* x1,
   std::vector<uint32_t> fill(s.bucketStart.begin(), s.bucketStart.end() - 1);
   for (size_t t = 0; t < nt; ++t) forCells(t, [&](uint32_t b) { s.entry[fill[b]++] = static_cast<int>(t); });
 }
-
-}  // namespace
-
-namespace {
 
 // the four particles of one test (ids local to the piece), gathered and written back
 struct Four {
@@ -112,9 +106,9 @@ struct Four {
   }
 };
 
-// calls f(primitive) for every primitive hashed into the cell of point q (and whose box holds it)
+// calls f(triangle) for every triangle hashed into the cell of point q (and whose box holds it)
 template <typename F>
-void forPrimitivesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F&& f) {
+void forTrianglesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F&& f) {
   const int ci = static_cast<int>(std::floor(q.x() / cell)), cj = static_cast<int>(std::floor(q.y() / cell)),
             ck = static_cast<int>(std::floor(q.z() / cell));
   const uint32_t b = bucketOf(ci, cj, ck);
@@ -129,33 +123,34 @@ void forPrimitivesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F
 
 }  // namespace
 
-int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int first, int count, const std::vector<float>& invMass,
-                float thickness, Particles& p, SelfCollisionScratch& s) {
+int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int first, int count,
+                const std::vector<float>& invMass, float thickness, Particles& p, SelfCollisionScratch& s) {
   if (tris.empty() || count == 0) return 0;
   const Vec3* x0 = p.x.data() + first;
   Vec3* x1 = p.xPred.data() + first;
   Vec3* vel = p.v.data() + first;
-  float move = 0.0f, edge = 0.0f;
-  for (int i = 0; i < count; ++i) move = std::max(move, (x1[i] - x0[i]).norm());
+  float edge = 0.0f;
   for (const auto& t : tris) edge += (x1[t[1]] - x1[t[0]]).norm();
   s.moved.assign(static_cast<size_t>(count), 0);
   int pushes = 0;
-  // a vertex near a triangle lies in its box padded by the thickness (and the step's largest motion,
-  // for the pushes before it)
-  const float pad = thickness + move;
+  // a vertex within the thickness of a triangle lies in its box padded by the thickness; the boxes
+  // are built once, so the pad holds another thickness for the pushes of the passes. Not the step's
+  // motion: a fast garment would make the cells, and every candidate list, as large as the piece
+  const float pad = 2.0f * thickness;
   const float cell = std::max(edge / float(tris.size()), 2.0f * pad);
-  hashPrimitives(tris, x1, cell, pad, s);
-  for (int pass = 0; pass < kPasses; ++pass)
-  for (int i = 0; i < count; ++i) {
-    if (invMass[i] == 0.0f) continue;
-    forPrimitivesAt(x1[i], cell, s, [&](int t) {
-      const auto& tri = tris[t];
-      if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
-      Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
-      if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) return;
-      f.store(x1, vel, s.moved);
-      ++pushes;
-    });
+  hashTriangles(tris, x1, cell, pad, s);
+  for (int pass = 0; pass < kPasses; ++pass) {
+    for (int i = 0; i < count; ++i) {
+      if (invMass[i] == 0.0f) continue;
+      forTrianglesAt(x1[i], cell, s, [&](int t) {
+        const auto& tri = tris[t];
+        if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
+        Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
+        if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) return;
+        f.store(x1, vel, s.moved);
+        ++pushes;
+      });
+    }
   }
   return pushes;
 }

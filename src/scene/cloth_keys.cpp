@@ -63,6 +63,13 @@ int nearestVertex(const TriangleMesh& mesh, const Vec3& p) {
 const std::vector<std::string> kRectangleKeys = {"center", "size", "resolution", "axisU", "axisV"};
 const std::vector<std::string> kObjKeys = {"path", "scale", "translate", "rotate"};
 
+// true when the mesh has at most limit.count vertices, else logs at `path` why not
+bool withinLimit(ErrorLog& log, const std::string& path, const TriangleMesh& mesh, const ParticleLimit& limit) {
+  if (int64_t(mesh.vertices.size()) <= limit.count) return true;
+  log.error(path, fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why, mesh.vertices.size()));
+  return false;
+}
+
 // a sewn garment (world/pattern.hpp): its panels and seams into spec; only the implicit solver sews
 std::optional<TriangleMesh> readPatternPiece(ObjectReader& m, const std::string& baseDir, const ParticleLimit& limit,
                                              const Bodies& bodies, ClothSolver solver, ClothSpec& spec) {
@@ -71,12 +78,7 @@ std::optional<TriangleMesh> readPatternPiece(ObjectReader& m, const std::string&
   if (solver != ClothSolver::Implicit)
     m.log().error(m.path(), "expected \"solver\": \"implicit\" on the piece (a pattern's seams are springs of the "
                             "implicit solver), got a pattern mesh on a PBD piece");
-  if (!g) return std::nullopt;
-  if (int64_t(g->mesh.vertices.size()) > limit.count) {
-    m.log().error(m.path(), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
-                                        g->mesh.vertices.size()));
-    return std::nullopt;
-  }
+  if (!g || !withinLimit(m.log(), m.path(), g->mesh, limit)) return std::nullopt;
   spec.panelOfVertex = std::move(g->panelOfVertex);
   spec.seams = std::move(g->seamPairs);
   return std::move(g->mesh);
@@ -94,11 +96,7 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
   if (type == 2) {
     std::optional<TriangleMesh> mesh = readGarmentMesh(m, bodies, spec.panelOfVertex);
     m.finish(concat(concat(kRectangleKeys, kObjKeys), {"pattern"}), "a garment mesh");
-    if (mesh && int64_t(mesh->vertices.size()) > limit.count) {
-      log.error(m.path(), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
-                                      mesh->vertices.size()));
-      return std::nullopt;
-    }
+    if (mesh && !withinLimit(log, m.path(), *mesh, limit)) return std::nullopt;
     return mesh;
   }
   if (type == 0) {
@@ -141,11 +139,7 @@ std::optional<TriangleMesh> readMesh(ObjectReader m, const std::string& baseDir,
       TriangleMesh mesh = loadObjMesh(resolved.string());
       // scale, then rotate, then translate
       for (Vec3& x : mesh.vertices) x = rotate * (scale * x) + translate;
-      if (int64_t(mesh.vertices.size()) > limit.count) {
-        log.error(m.pathOf("path"), fmt::format("expected at most {} vertices ({}), got {}", limit.count, limit.why,
-                                                mesh.vertices.size()));
-        return std::nullopt;
-      }
+      if (!withinLimit(log, m.pathOf("path"), mesh, limit)) return std::nullopt;
       return mesh;
     } catch (const Error& e) {
       log.error(m.pathOf("path"), e.what());
