@@ -14,7 +14,11 @@ bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x
   const Vec3 n1 = n1raw / area2;
   const float dist1 = (x1[0] - x1[1]).dot(n1);
   const Vec3 n0raw = (x0[2] - x0[1]).cross(x0[3] - x0[1]);
-  const float dist0 = n0raw.squaredNorm() > 1e-24f ? (x0[0] - x0[1]).dot(n0raw.normalized()) : dist1;
+  const Vec3 n0 = n0raw.squaredNorm() > 1e-24f ? Vec3(n0raw.normalized()) : n1;
+  // a triangle that turned by more than 60 degrees in one step (crumpling, or inverting) has no side
+  // to compare: with its normal flipped, a vertex that never crossed it would be pushed through it
+  if (n0.dot(n1) < 0.5f) return false;
+  const float dist0 = (x0[0] - x0[1]).dot(n0);
   // the side the vertex started on; a vertex that started in the plane keeps the side it ends on
   const float side = std::abs(dist0) > 1e-7f ? (dist0 > 0.0f ? 1.0f : -1.0f) : (dist1 >= 0.0f ? 1.0f : -1.0f);
   if (side * dist1 >= d) return false;

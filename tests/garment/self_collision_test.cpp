@@ -41,6 +41,23 @@ TEST(GarmentSelfCollision, ClearVerticesAndPinnedPairsAreLeftAlone) {
   EXPECT_LT(below[0].z(), below[1].z());
 }
 
+// a triangle that flipped over during the step (two of its corners swapped sides, as in a crumpling
+// fold) has no side to keep: the vertex that stayed above it is not pushed through it. Compared with
+// the same vertex under a triangle that only moved, which is put back.
+TEST(GarmentSelfCollision, AFlippedTriangleDoesNotPushAVertexThrough) {
+  const std::array<float, 4> w = {1.0f, 1.0f, 1.0f, 1.0f};
+  std::array<Vec3, 4> v{};
+  const std::array<Vec3, 4> x0 = startAbove(0.005f);
+  // the end: b and c swapped (the normal turned from +z to -z), the vertex still 5 mm above the plane
+  std::array<Vec3, 4> flipped = {Vec3(0.25f, 0.25f, 0.005f), Vec3(0, 0, 0), Vec3(0, 1, 0), Vec3(1, 0, 0)};
+  const std::array<Vec3, 4> before = flipped;
+  EXPECT_FALSE(pushVertexOffTriangle(x0, flipped, v, w, 0.008f));
+  EXPECT_EQ(flipped, before);
+  std::array<Vec3, 4> moved = startAbove(0.005f);  // not flipped: within the thickness, pushed to it
+  ASSERT_TRUE(pushVertexOffTriangle(x0, moved, v, w, 0.008f));
+  EXPECT_GT(moved[0].z(), 0.005f);
+}
+
 TEST(GarmentSelfCollision, ASheetDroppedOnAnotherStaysOnIt) {
   // two 2 x 2 quads of the same piece: the upper one's vertices fall through the lower one's plane
   Particles p;
