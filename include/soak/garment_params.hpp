@@ -69,6 +69,12 @@ struct SeamParams {
   bool gravityWhileClosing = false;  // false: the piece feels no gravity before closeTime, as garment tools sew
 };
 
+// the preconditioner of the conjugate gradient of Eq. 5 (garment/block_cg.hpp)
+enum class CgPreconditioner : uint8_t {
+  BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap per iteration, hundreds of iterations on stiff cloth
+  Cholesky,     // the exact sparse Cholesky factor of the filtered system: one iteration, a costly factor
+};
+
 // everything the implicit garment solver of one cloth piece reads (implicit.hpp)
 struct GarmentParams {
   SpringLaws laws;                    // KES laws (Eq. 11, 14)
@@ -83,6 +89,7 @@ struct GarmentParams {
   float rayleighBeta = 3.81413e-3f;   // s, stiffness-proportional damping (Eq. 22)
   float cgTolerance = 1e-4f;          // relative preconditioned residual
   int cgMaxIterations = 300;
+  CgPreconditioner cgPreconditioner = CgPreconditioner::BlockJacobi;
   bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
 };
 

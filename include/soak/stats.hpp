@@ -40,6 +40,7 @@ struct GarmentStats {
   double maxResidual = 0.0;     // largest relative CG residual at exit
   uint64_t unconverged = 0;     // solves whose CG stopped at garment.cg.maxIterations (the step still ran)
   uint64_t breakdowns = 0;      // solves whose system was not positive definite
+  uint64_t factorFailures = 0;  // solves whose Cholesky preconditioner failed to factor (block Jacobi used)
   uint64_t contacts = 0;        // vertex-collider contacts
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)
   uint64_t selfContacts = 0;    // vertex-triangle pushes of an implicit piece's self-collision
@@ -48,7 +49,7 @@ struct GarmentStats {
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; contacts += o.contacts; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     return *this;
   }
 };

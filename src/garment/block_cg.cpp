@@ -48,43 +48,57 @@ double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::v
 
 namespace {
 
-// the solve's start: the block-Jacobi preconditioner P^-1 (the inverse of each diagonal block, the
-// first of its row), delta0 = filter(b)^T P^-1 filter(b), the scale the residual is measured against,
-// r = filter(b - A x), c = filter(P^-1 r) and deltaNew = r^T c
-void startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
-              const std::vector<Vec3d>& x, CgScratch& w, double& delta0, double& deltaNew) {
-  const int64_t n = A.rows;
-  w.r.resize(static_cast<size_t>(n));
-  w.c.resize(static_cast<size_t>(n));
-  w.q.resize(static_cast<size_t>(n));
-  w.s.resize(static_cast<size_t>(n));
-  w.precond.resize(static_cast<size_t>(n));
-  w.partial.resize(static_cast<size_t>(n));
-  parallelFor(n, [&](int64_t i) {
+// the block-Jacobi preconditioner: the inverse of each diagonal block (the first of its row)
+void invertDiagonal(const BlockMatrix& A, CgScratch& w) {
+  w.precond.resize(static_cast<size_t>(A.rows));
+  parallelFor(A.rows, [&](int64_t i) {
     bool ok = false;
     Eigen::Matrix3d inv;
     double det = 0.0;
     A.block[A.rowStart[i]].computeInverseAndDetWithCheck(inv, det, ok, 1e-300);
     w.precond[i] = ok ? inv : Eigen::Matrix3d::Identity();
-    w.partial[i] = constrained[i] ? 0.0 : b[i].dot(w.precond[i] * b[i]);
   });
-  delta0 = orderedSum(w.partial);
+}
 
-  // r = filter(b - A x), c = filter(P^-1 r)
+// s = filter(P^-1 r); returns r^T s, summed in row order
+double precondition(const std::vector<Vec3d>& r, const std::vector<uint8_t>& constrained, bool cholesky, CgScratch& w,
+                    std::vector<Vec3d>& s) {
+  const int64_t n = static_cast<int64_t>(r.size());
+  s.resize(r.size());
+  if (cholesky) w.cholesky.solve(r, constrained, s);
   rowsFor(n, [&](int64_t i) {
-    if (constrained[i]) {
-      w.r[i].setZero();
-      w.c[i].setZero();
-      w.partial[i] = 0.0;
-      return;
-    }
+    if (!cholesky) s[i] = constrained[i] ? Vec3d::Zero() : Vec3d(w.precond[i] * r[i]);
+    w.partial[i] = r[i].dot(s[i]);
+  });
+  return orderedSum(w.partial);
+}
+
+// the solve's start: the preconditioner (Cholesky, or block Jacobi if asked for or if the factor
+// fails), delta0 = filter(b)^T P^-1 filter(b), the scale the residual is measured against,
+// r = filter(b - A x), c = filter(P^-1 r) and deltaNew = r^T c; returns whether Cholesky is used
+bool startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
+              const std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w, CgResult& result, double& delta0,
+              double& deltaNew) {
+  const int64_t n = A.rows;
+  w.r.resize(static_cast<size_t>(n));
+  w.q.resize(static_cast<size_t>(n));
+  w.partial.resize(static_cast<size_t>(n));
+  bool cholesky = options.preconditioner == CgPreconditioner::Cholesky;
+  if (cholesky && !w.cholesky.factor(A, constrained)) {
+    result.factorFailed = true;
+    cholesky = false;
+  }
+  if (!cholesky) invertDiagonal(A, w);
+  rowsFor(n, [&](int64_t i) { w.r[i] = constrained[i] ? Vec3d::Zero() : b[i]; });
+  delta0 = precondition(w.r, constrained, cholesky, w, w.s);
+  rowsFor(n, [&](int64_t i) {  // r = filter(b - A x)
+    if (constrained[i]) return;
     Vec3d ax = Vec3d::Zero();
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) ax += A.block[k] * x[A.col[k]];
     w.r[i] = b[i] - ax;
-    w.c[i] = w.precond[i] * w.r[i];
-    w.partial[i] = w.r[i].dot(w.c[i]);
   });
-  deltaNew = orderedSum(w.partial);
+  deltaNew = precondition(w.r, constrained, cholesky, w, w.c);
+  return cholesky;
 }
 
 }  // namespace
@@ -92,9 +106,9 @@ void startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vect
 CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
                      std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w) {
   const int64_t n = A.rows;
-  double delta0 = 0.0, deltaNew = 0.0;
-  startPcg(A, b, constrained, x, w, delta0, deltaNew);
   CgResult result;
+  double delta0 = 0.0, deltaNew = 0.0;
+  const bool cholesky = startPcg(A, b, constrained, x, options, w, result, delta0, deltaNew);
   if (!(delta0 > 0.0)) delta0 = deltaNew;
   if (!(delta0 > 0.0)) {
     // nothing to solve (b and r are zero), or r^T P^-1 r < 0: the matrix is not positive definite
@@ -122,15 +136,13 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
       break;
     }
     const double alpha = deltaNew / cq;
-    // x += alpha c, r -= alpha q, s = P^-1 r (filtered rows of c, q, r are zero)
+    // x += alpha c, r -= alpha q (filtered rows of c, q, r are zero), s = filter(P^-1 r)
     rowsFor(n, [&](int64_t i) {
       x[i] += alpha * w.c[i];
       w.r[i] -= alpha * w.q[i];
-      w.s[i] = constrained[i] ? Vec3d::Zero() : Vec3d(w.precond[i] * w.r[i]);
-      w.partial[i] = w.r[i].dot(w.s[i]);
     });
     const double deltaOld = deltaNew;
-    deltaNew = orderedSum(w.partial);
+    deltaNew = precondition(w.r, constrained, cholesky, w, w.s);
     const double beta = deltaNew / deltaOld;
     rowsFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
     ++result.iterations;

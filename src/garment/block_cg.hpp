@@ -1,30 +1,25 @@
 // sparse symmetric matrices of 3x3 blocks (one row per cloth vertex) and the modified
 // preconditioned conjugate gradient of Baraff & Witkin 1998 (section 5.3) that Chen et al. 2012
 // use for Eq. 3-5: constrained vertices are filtered out of every search direction, so the solve
-// never moves them away from their prescribed value. Block-Jacobi preconditioner. Double precision;
-// every sum runs in a fixed order, so the result does not depend on the thread count.
+// never moves them away from their prescribed value. Preconditioned by the exact sparse Cholesky
+// factor of the filtered matrix (sparse_cholesky.hpp) or by block Jacobi. Double precision; every
+// sum runs in a fixed order, so the result does not depend on the thread count.
 #pragma once
+#include <soak/garment_params.hpp>
 #include <soak/math.hpp>
+
+#include "garment/block_matrix.hpp"
+#include "garment/sparse_cholesky.hpp"
 
 #include <cstdint>
 #include <vector>
 
 namespace soak {
 
-// block CSR: row i holds blocks [rowStart[i], rowStart[i + 1]); its diagonal block comes first
-struct BlockMatrix {
-  int rows = 0;
-  std::vector<int> rowStart;
-  std::vector<int> col;
-  std::vector<Eigen::Matrix3d> block;
-
-  // y = A x (gather per row)
-  void multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) const;
-};
-
 struct CgOptions {
   double tolerance = 1e-5;  // stop when sqrt(r^T P^-1 r / b^T P^-1 b) <= tolerance (filtered r, b)
   int maxIterations = 500;
+  CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;
 };
 
 struct CgResult {
@@ -32,11 +27,13 @@ struct CgResult {
   double residual = 0.0;   // the relative preconditioned residual at exit
   bool converged = false;
   bool breakdown = false;  // a direction with c^T A c <= 0: the matrix is not positive definite
+  bool factorFailed = false;  // the Cholesky factor failed (not positive definite): block Jacobi was used
 };
 
 struct CgScratch {
   std::vector<Vec3d> r, c, q, s;
-  std::vector<Eigen::Matrix3d> precond;  // inverse diagonal blocks
+  std::vector<Eigen::Matrix3d> precond;  // inverse diagonal blocks (block Jacobi)
+  SparseCholesky cholesky;               // the factor and its pattern, kept from solve to solve
   std::vector<double> partial;           // per-chunk partial sums of the dot products
 };
 

@@ -332,11 +332,13 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   CgOptions opt;
   opt.tolerance = params.cgTolerance;
   opt.maxIterations = params.cgMaxIterations;
+  opt.preconditioner = params.cgPreconditioner;
   const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg);
   stats.cgIterations = cg.iterations;
   stats.cgResidual = cg.residual;
   stats.converged = cg.converged;
   stats.breakdown = cg.breakdown;
+  stats.factorFailed = cg.factorFailed;
   integrateWithContact(model, g, params, h, poses, saturation, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision)

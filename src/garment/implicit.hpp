@@ -73,6 +73,7 @@ struct ImplicitStats {
   double cgResidual = 0.0;   // relative, at exit
   bool converged = true;     // false: the CG hit cgMaxIterations (or broke down); the step still ran
   bool breakdown = false;    // the system was not positive definite
+  bool factorFailed = false; // the Cholesky preconditioner failed to factor: block Jacobi was used
   int constrainedVertices = 0;  // pinned + disturbed
   int contacts = 0;             // vertices pushed out of a collider
   int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider

@@ -200,6 +200,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.maxResidual = std::max(gs.maxResidual, r.cgResidual);
     gs.unconverged += r.converged ? 0 : 1;
     gs.breakdowns += r.breakdown ? 1 : 0;
+    gs.factorFailures += r.factorFailed ? 1 : 0;
     gs.contacts += static_cast<uint64_t>(r.contacts);
     gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
     gs.selfContacts += static_cast<uint64_t>(r.selfContacts);

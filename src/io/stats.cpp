@@ -85,6 +85,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"cgMaxResidual", g.maxResidual},
                     {"unconvergedSolves", g.unconverged},
                     {"breakdowns", g.breakdowns},
+                    {"factorFailures", g.factorFailures},
                     {"contacts", g.contacts},
                     {"edgeContacts", g.edgeContacts},
                     {"selfContacts", g.selfContacts},
