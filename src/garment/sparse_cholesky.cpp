@@ -58,6 +58,7 @@ void SparseCholesky::solve(const std::vector<Vec3d>& r, const std::vector<uint8_
                            std::vector<Vec3d>& s) const {
   const Eigen::Index n = static_cast<Eigen::Index>(r.size()) * 3;
   s.resize(r.size());
+  if (r.empty()) return;
   Eigen::Map<Eigen::VectorXd>(s[0].data(), n) = llt_->solve(Eigen::Map<const Eigen::VectorXd>(r[0].data(), n));
   for (size_t i = 0; i < r.size(); ++i)
     if (constrained[i]) s[i].setZero();
