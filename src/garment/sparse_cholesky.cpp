@@ -5,32 +5,35 @@
 
 namespace soak {
 
+namespace {
+
+// calls f(k, a, b, row, column) for every scalar entry (a, b) of block k of A on or below the diagonal
+template <class F>
+void forLowerEntries(const BlockMatrix& A, F&& f) {
+  for (int i = 0; i < A.rows; ++i)
+    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          if (3 * i + a >= 3 * A.col[k] + b) f(k, a, b, 3 * i + a, 3 * A.col[k] + b);
+}
+
+}  // namespace
+
 void SparseCholesky::buildPattern(const BlockMatrix& A) {
   rowStart_ = A.rowStart;
   col_ = A.col;
-  const int n = A.rows;
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(A.col.size() * 6);
-  for (int i = 0; i < n; ++i)
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k)
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          if (3 * i + a >= 3 * A.col[k] + b) entries.emplace_back(3 * i + a, 3 * A.col[k] + b, 0.0);
-  lower_.resize(3 * n, 3 * n);
+  forLowerEntries(A, [&](int, int, int, int row, int column) { entries.emplace_back(row, column, 0.0); });
+  lower_.resize(3 * A.rows, 3 * A.rows);
   lower_.setFromTriplets(entries.begin(), entries.end());
   lower_.makeCompressed();
   valueOf_.assign(A.col.size() * 9, -1);
-  const auto indexOf = [&](int row, int column) {
-    const int* rows = lower_.innerIndexPtr();
-    const int* begin = rows + lower_.outerIndexPtr()[column];
-    const int* end = rows + lower_.outerIndexPtr()[column + 1];
-    return static_cast<int>(std::lower_bound(begin, end, row) - rows);
-  };
-  for (int i = 0; i < n; ++i)
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k)
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          if (3 * i + a >= 3 * A.col[k] + b) valueOf_[9 * k + 3 * a + b] = indexOf(3 * i + a, 3 * A.col[k] + b);
+  const int* rows = lower_.innerIndexPtr();
+  const int* outer = lower_.outerIndexPtr();
+  forLowerEntries(A, [&](int k, int a, int b, int row, int column) {
+    valueOf_[9 * k + 3 * a + b] = static_cast<int>(std::lower_bound(rows + outer[column], rows + outer[column + 1], row) - rows);
+  });
   llt_ = std::make_unique<Llt>();
   llt_->analyzePattern(lower_);
 }
@@ -39,17 +42,12 @@ bool SparseCholesky::factor(const BlockMatrix& A, const std::vector<uint8_t>& co
   if (A.rowStart != rowStart_ || A.col != col_) buildPattern(A);
   double* values = lower_.valuePtr();
   std::fill(values, values + lower_.nonZeros(), 0.0);
-  for (int i = 0; i < A.rows; ++i)
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) {
-      const int j = A.col[k];
-      const bool filtered = constrained[i] || constrained[j];
-      if (filtered && i != j) continue;  // a constrained vertex is coupled to nothing
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) {
-          const int slot = valueOf_[9 * k + 3 * a + b];
-          if (slot >= 0) values[slot] += filtered ? (a == b ? 1.0 : 0.0) : A.block[k](a, b);
-        }
-    }
+  forLowerEntries(A, [&](int k, int a, int b, int row, int column) {
+    const int i = row / 3, j = column / 3;
+    const bool filtered = constrained[i] || constrained[j];
+    if (filtered && i != j) return;  // a constrained vertex is coupled to nothing
+    values[valueOf_[9 * k + 3 * a + b]] += filtered ? (a == b ? 1.0 : 0.0) : A.block[k](a, b);
+  });
   llt_->factorize(lower_);
   return llt_->info() == Eigen::Success;
 }

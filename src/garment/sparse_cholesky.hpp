@@ -32,7 +32,7 @@ class SparseCholesky {
   void buildPattern(const BlockMatrix& A);
 
   Eigen::SparseMatrix<double> lower_;  // lower triangle of the filtered matrix, scalar, column-major
-  std::vector<int> valueOf_;           // per block k and entry 3a + b: index into lower_'s values, -1 above the diagonal
+  std::vector<int> valueOf_;           // per block k and entry 3a + b: index into lower_'s values (-1 above the diagonal, never read)
   std::vector<int> rowStart_, col_;    // the block pattern lower_ was built for
   using Llt = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
   std::unique_ptr<Llt> llt_;  // on the heap: Eigen's solvers cannot be moved, the scratch that holds this can
