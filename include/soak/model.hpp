@@ -24,7 +24,9 @@ struct Keyframe {
   Quat rotation{1, 0, 0, 0};
 };
 
-enum class ColliderShape { Plane, Box, Container, Sphere, Capsule, Mesh };
+// Body: a smooth union of sphere, capsule and box parts, each moved by its own keys (a skinned body:
+// the built-in mannequin, docs/mannequin.md)
+enum class ColliderShape { Plane, Box, Container, Sphere, Capsule, Mesh, Body };
 
 // signed distance grid of a closed triangle mesh (src/world/mesh_sdf.hpp); immutable once built
 struct SdfGrid;
@@ -44,6 +46,10 @@ struct Collider {
   // mesh: the signed distance grid of a closed OBJ in the local frame, shared by copies of the
   // collider (read-only, so sharing is safe and a Model copy stays cheap)
   std::shared_ptr<const SdfGrid> sdf;
+  // body: its parts (sphere, capsule or box colliders; their keys relative to this collider's keys),
+  // shared and read-only, and the radius k of the smooth minimum that joins them (m, > 0)
+  std::shared_ptr<const std::vector<Collider>> parts;
+  float blendRadius = 0.0f;
   float friction = 0.3f;               // kinetic Coulomb coefficient, mixed with the particle's (core/friction.hpp)
   float staticFriction = 0.3f;         // static Coulomb coefficient, >= friction
   float restitution = 0.0f;            // 0..1: normal velocity kept, reversed, on contact

@@ -194,7 +194,7 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
 // removed normal velocity as its impulse; x gives back the slip friction removed during the step
 void contactResponse(const Collider& collider, const ColliderPose& pose, const Vec3& nrm, float muFabric, float h,
                      Vec3& x, Vec3& vel) {
-  const Vec3 vCol = pose.velocityAt(x);
+  const Vec3 vCol = colliderVelocity(collider, pose, x);
   Vec3 rel = vel - vCol;
   const float dvn = std::max(-rel.dot(nrm), 0.0f);
   rel += dvn * nrm;  // the inward velocity is removed
@@ -229,10 +229,8 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
     bool contact = false;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm;
-      const float d = colliderDistance(model.colliders[c], poses[c], x, &nrm) - margin;
-      if (d >= 0.0f) continue;
+      if (!pushOutOf(model.colliders[c], poses[c], margin, x, &nrm)) continue;  // project out to the margin
       contact = true;
-      x -= d * nrm;  // project out to the margin
       contactResponse(model.colliders[c], poses[c], nrm, muFabric, h, x, vel);
     }
     p.xPred[i] = x;
@@ -304,9 +302,7 @@ int selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vect
     if (!w.self.moved[v] || w.invMass[v] == 0.0f) continue;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm;
-      const float d = colliderDistance(model.colliders[c], poses[c], p.xPred[first + v], &nrm) - margin;
-      if (d >= 0.0f) continue;
-      p.xPred[first + v] -= d * nrm;
+      if (!pushOutOf(model.colliders[c], poses[c], margin, p.xPred[first + v], &nrm)) continue;
       contactResponse(model.colliders[c], poses[c], nrm, 0.0f, 0.0f, p.xPred[first + v], p.v[first + v]);
     }
   }

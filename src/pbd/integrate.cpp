@@ -75,7 +75,7 @@ void updateColliderPoses(const Model& model, double time, std::span<const std::v
   poses.resize(model.colliders.size());
   for (size_t c = 0; c < model.colliders.size(); ++c) {
     const bool given = c < colliderKeys.size() && !colliderKeys[c].empty();
-    poses[c] = given ? keyframedPose(colliderKeys[c], time) : colliderPose(model.colliders[c], time);
+    poses[c] = colliderPose(model.colliders[c], given ? std::span<const Keyframe>(colliderKeys[c]) : model.colliders[c].keys, time);
   }
 }
 

@@ -103,6 +103,14 @@ void collider(Buf& b, const Collider& c, const ColliderPose& pose, const Surface
       mesh2(b, mesh->vertices, usableNormals(mesh->vertices, mesh->normals, mesh->triangles), mesh->triangles, {},
             "texture { Solid }");
       break;
+    case ColliderShape::Body:
+      // its smooth skin at this frame's pose, meshed in the world frame (render.cpp)
+      if (mesh == nullptr || mesh->triangles.empty()) return;
+      b.append(std::string_view("object {\n"));
+      mesh2(b, mesh->vertices, usableNormals(mesh->vertices, mesh->normals, mesh->triangles), mesh->triangles, {},
+            "texture { Solid }");
+      b.append(std::string_view("}\n"));
+      return;
     case ColliderShape::Plane: {
       const Vec3 n = pose.rotation * Vec3(0, 1, 0);
       b.append(std::string_view("plane { "));
@@ -185,6 +193,17 @@ Bounds colliderBounds(const Collider& c, const ColliderPose& pose) {
       local.add(Vec3(0, -c.halfHeight, 0), c.radius);
       local.add(Vec3(0, c.halfHeight, 0), c.radius);
       break;
+    case ColliderShape::Body: {
+      // its parts' boxes, grown by the blend radius (the skin is within it of the parts' union)
+      Bounds world;
+      for (size_t k = 0; c.parts && k < c.parts->size() && k < pose.parts.size(); ++k)
+        world.add(colliderBounds((*c.parts)[k], pose.parts[k]));
+      if (world.empty()) return world;
+      const Vec3 lo = world.lo, hi = world.hi;
+      world.add(lo, c.blendRadius);
+      world.add(hi, c.blendRadius);
+      return world;
+    }
   }
   Bounds world;
   if (local.empty()) return world;  // a mesh without its distance grid: nothing to frame

@@ -89,6 +89,17 @@ std::string renderFrame(const FrameJob& job, int frame) {
   in.model = &model;
   in.poses = posesAt(model, run.timeOf(frame));
   for (const SurfaceMesh& m : job.colliderMeshes) in.colliderMesh.push_back(&m);
+  // a Body's skin moves with its parts: meshed at this frame's pose, kBodyCells cells along its longest side
+  constexpr float kBodyCells = 300.0f;
+  std::vector<SurfaceMesh> skins(model.colliders.size());
+  for (size_t k = 0; k < model.colliders.size() && k < in.colliderMesh.size(); ++k) {
+    const Collider& c = model.colliders[k];
+    if (c.shape != ColliderShape::Body) continue;
+    const Bounds box = colliderBounds(c, in.poses[k]);
+    if (box.empty()) continue;
+    skins[k] = colliderSurfaceMesh(c, in.poses[k], box.lo, box.hi, (box.hi - box.lo).maxCoeff() / kBodyCells);
+    in.colliderMesh[k] = &skins[k];
+  }
   in.cloth = &cloth;
   in.clothColor = clothColors(cloth, job.ramp, cloth.saturationMax > 0.0f ? cloth.saturationMax
                                                                           : model.wetting.saturationMax);

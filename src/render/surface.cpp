@@ -1,6 +1,8 @@
 // water surface: particles -> narrow-band level set -> smoothed, eroded -> triangle mesh (OpenVDB)
 #include "render/surface.hpp"
 
+#include "world/colliders.hpp"
+
 #include <fmt/format.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/LevelSetFilter.h>
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <soak/error.hpp>
 
@@ -197,6 +200,31 @@ SurfaceMesh sdfGridMesh(const SdfGrid& sdf) {
   // the inside, beyond the band, must read as negative for the mesher
   openvdb::tools::signedFloodFill(grid->tree());
   return meshGrid(*grid);
+}
+
+SurfaceMesh colliderSurfaceMesh(const Collider& c, const ColliderPose& pose, const Vec3& lo, const Vec3& hi,
+                                float cellSize) {
+  SdfGrid sdf;
+  sdf.cellSize = cellSize;
+  sdf.origin = lo - Vec3::Constant(2.0f * cellSize);
+  int64_t nodes = 1;
+  for (int a = 0; a < 3; ++a) {
+    const float cells = std::ceil((hi[a] - lo[a]) / cellSize) + 4.0f;
+    if (!(cells >= 1.0f && cells < 4096.0f)) return {};
+    sdf.dims[a] = int(cells) + 1;
+    nodes *= sdf.dims[a];
+  }
+  if (nodes > kMaxSdfNodes) return {};
+  std::vector<float> points(size_t(3 * nodes));
+  for (int64_t n = 0; n < nodes; ++n) {
+    const int64_t i = n % sdf.dims[0], j = (n / sdf.dims[0]) % sdf.dims[1], k = n / (int64_t(sdf.dims[0]) * sdf.dims[1]);
+    const Vec3 x = sdf.origin + cellSize * Vec3(float(i), float(j), float(k));
+    std::copy(x.data(), x.data() + 3, points.begin() + 3 * n);
+  }
+  sdf.value.assign(size_t(nodes), std::numeric_limits<float>::max());
+  colliderDistanceBounds(c, pose, points.data(), nodes, sdf.value.data());
+  for (float& v : sdf.value) v += kDistanceBoundSlack;  // the bound is the distance less this slack
+  return sdfGridMesh(sdf);
 }
 
 double enclosedVolume(const SurfaceMesh& mesh) {

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "world/colliders.hpp"
+
 namespace soak {
 
 // a triangle mesh, outward facing: counter-clockwise seen from outside
@@ -50,6 +52,12 @@ SurfaceMesh levelSetMesh(const WaterLevelSet& levelSet);
 // the zero level of a mesh collider's signed distance grid as triangles, in the collider's local frame
 // (for drawing it; the grid is what the solver sees)
 SurfaceMesh sdfGridMesh(const SdfGrid& grid);
+
+// the zero level of a collider's distance at a pose, sampled (colliderDistanceBounds) on a grid of
+// spacing cellSize over the world box [lo, hi], in the world frame: how a Body's smooth skin is drawn
+// each frame. Empty when the box would need more than kMaxSdfNodes nodes
+SurfaceMesh colliderSurfaceMesh(const Collider& c, const ColliderPose& pose, const Vec3& lo, const Vec3& hi,
+                                float cellSize);
 
 // volume enclosed by a closed, outward-facing mesh (divergence theorem), m^3
 double enclosedVolume(const SurfaceMesh& mesh);

@@ -150,12 +150,13 @@ std::vector<Collider> readMannequin(ObjectReader& r, const std::string& name, Bo
         key.pose = readMannequinPose(k.object("pose"));
       });
   m.sampleInterval = r.number("sampleInterval", d.sampleInterval, Range::positive());
+  m.blend = r.number("blend", d.blend, Range::between(0.0, 0.1));
   r.finish({"normal", "halfExtents", "wallThickness", "radius", "halfHeight", "path", "resolution", "padding",
             "restitution", "rotation"},
            "a mannequin collider");
   if (log.messages().size() != errorsBefore) return {};
   try {
-    std::vector<Collider> cols = buildMannequin(m, keys, friction, name, r.path());
+    std::vector<Collider> cols = mannequinColliders(m, keys, friction, name, r.path());
     bodies[name] = BodySpec{m, keys, cols};
     return cols;
   } catch (const Error& e) {

@@ -22,8 +22,9 @@ struct BodySpec {
 };
 using Bodies = std::map<std::string, BodySpec>;
 
-// a "mannequin" collider entry (r is the entry, its name and type already read): the colliders
-// <name>.head ... <name>.foot_r, also remembered in bodies[name]. Empty when invalid (logged).
+// a "mannequin" collider entry (r is the entry, its name and type already read): the colliders,
+// one smooth body <name> (blend > 0) or its parts <name>.head ... <name>.foot_r (mannequinColliders),
+// also remembered in bodies[name]. Empty when invalid (logged).
 std::vector<Collider> readMannequin(ObjectReader& r, const std::string& name, Bodies& bodies);
 
 // the shape keys of a "mesh" collider (path, resolution, padding): sets c.sdf; false when invalid

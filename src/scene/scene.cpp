@@ -318,6 +318,8 @@ std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, 
       readMeshColliderShape(r, c, baseDir);
       mine = {"path", "resolution", "padding"};
       break;
+    case ColliderShape::Body:  // only a "mannequin" makes one (read above)
+      break;
   }
   readFriction(r, d.friction, c.friction, c.staticFriction);
   c.restitution = r.number("restitution", d.restitution, Range::unit());

@@ -33,6 +33,12 @@ float thicknessOf(const Collider& c) {
     case ColliderShape::Box: return 2.0f * c.halfExtents.minCoeff();
     case ColliderShape::Container: return c.wallThickness;
     case ColliderShape::Mesh: return c.sdf ? 2.0f * c.sdf->cellSize : std::numeric_limits<float>::infinity();
+    case ColliderShape::Body: {
+      float thinnest = std::numeric_limits<float>::infinity();
+      if (c.parts)
+        for (const Collider& part : *c.parts) thinnest = std::min(thinnest, thicknessOf(part));
+      return thinnest;
+    }
   }
   return 0.0f;
 }
@@ -109,12 +115,12 @@ struct ContactResult {
 // on; one found inside: out along the nearest normal), then Coulomb friction acts on its slip
 // relative to the surface. `repeat`: a later pass over the parts, which only pushes out what the
 // other parts pushed in (the friction of this substep's contacts has acted)
-ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose, const Vec3& x, Vec3& xp,
+ContactResult contactWith(const ContactPart& part, const Collider& owner, const ColliderPose& ownerPose, const Vec3& x, Vec3& xp,
                           float margin, float dt, FrictionCoefficients mu, bool repeat, Vec3* normal) {
   ContactResult r;
   Vec3 nrm;
   const float rawEnd = colliderDistance(part.shape, part.pose, xp, &nrm);
-  const Vec3 from = x + ownerPose.velocityAt(x) * dt;  // the start, carried with the collider
+  const Vec3 from = x + colliderVelocity(owner, ownerPose, x) * dt;  // the start, carried with the collider
   const float length = (xp - from).norm();
   float d = rawEnd - margin;
   // clear at the end and shorter than the part is thick: it cannot have passed through it
@@ -143,9 +149,12 @@ ContactResult contactWith(const ContactPart& part, const ColliderPose& ownerPose
   // still within the margin (a concave mesh, or a box's edge that the start's face did not cover): the
   // nearest face as well
   const float after = colliderDistance(part.shape, part.pose, xp, &n0);
-  if (after < margin - 1e-6f) xp -= (after - margin) * n0;
+  if (after < margin - 1e-6f) {
+    xp -= (after - margin) * n0;
+    if (part.shape.shape == ColliderShape::Body) pushOutOf(part.shape, part.pose, margin - 1e-6f, xp, &n0);  // one push may fall short
+  }
   if (!repeat) {
-    const Vec3 slip = (xp - x) - ownerPose.velocityAt(xp) * dt;  // motion relative to the surface
+    const Vec3 slip = (xp - x) - colliderVelocity(owner, ownerPose, xp) * dt;  // motion relative to the surface
     xp += coulombFriction(slip, nrm, mu, -d) - slip;                // the normal push -d limits the friction
   }
   *normal = nrm;
@@ -181,16 +190,15 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
   for (size_t c = 0; c < numColliders; ++c)
     colliderDistanceBounds(model.colliders[c], poses[c], p.xPred[0].data(), n, distanceBound.data());
   const std::vector<ContactPart> parts = contactParts(model, poses, numColliders);
-  const bool anyMoves = std::any_of(poses.begin(), poses.begin() + numColliders, [](const ColliderPose& pose) {
-    return !pose.linearVelocity.isZero() || !pose.angularVelocity.isZero();
-  });
+  const bool anyMoves =
+      std::any_of(poses.begin(), poses.begin() + numColliders, [](const ColliderPose& pose) { return pose.moving(); });
   std::atomic<uint64_t> putBack{0};
   parallelForRanges(moved, [&](int64_t i) {
     if (!(p.invMass[i] > 0.0f)) return;
     const float margin = contactMargin(model, p.phase[i]);
     float carried = 0.0f;  // how far the colliders carry the start in this substep
     for (size_t c = 0; anyMoves && c < numColliders; ++c)
-      carried = std::max(carried, poses[c].velocityAt(p.x[i]).norm() * dt);
+      carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], p.x[i]) * dt);
     Vec3 xp = p.xPred[i];
     if (distanceBound[i] >= margin + (xp - p.x[i]).norm() + carried) return;
     // a push out of one part can put x* into another met before it (a container's wall after its
@@ -202,7 +210,7 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
       size_t lastPush = 0;
       for (size_t k = 0; k < end; ++k) {
         const ContactPart& part = parts[k];
-        const ContactResult r = contactWith(part, poses[part.owner], p.x[i], xp, margin, dt,
+        const ContactResult r = contactWith(part, model.colliders[part.owner], poses[part.owner], p.x[i], xp, margin, dt,
                                             frictionOf(model, model.colliders[part.owner], p.phase[i]), pass > 0,
                                             &contactNormal[i]);
         caught += r.putBack ? 1 : 0;
@@ -236,7 +244,7 @@ void applyColliderRestitution(const Model& model, const std::vector<ColliderPose
         best = c;
       }
     }
-    const Vec3 vCol = poses[best].velocityAt(xp);
+    const Vec3 vCol = colliderVelocity(model.colliders[best], poses[best], xp);
     const float vn = (p.v[i] - vCol).dot(nrm);
     if (vn >= 0.0f) return;
     // new relative normal velocity = -e vn

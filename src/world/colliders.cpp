@@ -1,11 +1,16 @@
-// rigid colliders: keyframed poses, exact signed distance functions, contact projection with
-// friction, restitution. Shapes live in the collider's local frame (see model.hpp).
+// colliders: keyframed poses, exact signed distance functions (a Body's: the smooth union of its
+// parts'), surface velocities. Shapes live in the collider's local frame (see model.hpp).
 #include "world/colliders.hpp"
 
 #include "world/container.hpp"
 #include "world/mesh_sdf.hpp"
+#include "world/smooth_min.hpp"
 
 #include "core/parallel.hpp"
+
+#include <soak/error.hpp>
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -86,14 +91,94 @@ float localDistance(const Collider& c, const Vec3& p, Vec3* n) {
       if (c.sdf) return sampleSdf(*c.sdf, p, n);
       *n = Vec3(0, 1, 0);
       return 1.0e30f;
+    case ColliderShape::Body: break;  // in world space, from its parts' poses (blendDistance)
   }
   *n = Vec3(0, 1, 0);
-  return p.y();
+  return 1.0e30f;
+}
+
+// the pose `local` given relative to `root`, in the world, with the velocities of both motions
+ColliderPose composePose(const ColliderPose& root, const ColliderPose& local) {
+  ColliderPose w;
+  const Vec3 arm = root.rotation * local.translation;
+  w.translation = root.translation + arm;
+  w.rotation = (root.rotation * local.rotation).normalized();
+  w.linearVelocity = root.linearVelocity + root.angularVelocity.cross(arm) + root.rotation * local.linearVelocity;
+  w.angularVelocity = root.angularVelocity + root.rotation * local.angularVelocity;
+  return w;
+}
+
+// a Body's smooth union at world point p: the parts' distances folded by smoothMin in part order,
+// their normals and surface velocities blended with the same weights (the gradient's chain rule);
+// `slope`: the gradient's length (<= 1)
+float blendDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal, Vec3* velocity,
+                    float* slope = nullptr) {
+  const size_t count = c.parts ? c.parts->size() : 0;
+  if (count == 0 || pose.parts.size() != count) {
+    if (normal) *normal = Vec3(0, 1, 0);
+    if (velocity) *velocity = Vec3::Zero();
+    return 1.0e30f;
+  }
+  Vec3 grad, vel = Vec3::Zero();
+  float d = colliderDistance((*c.parts)[0], pose.parts[0], p, &grad);
+  if (velocity) vel = pose.parts[0].velocityAt(p);
+  for (size_t k = 1; k < count; ++k) {
+    Vec3 nk;
+    const float dk = colliderDistance((*c.parts)[k], pose.parts[k], p, &nk);
+    if (dk - d >= c.blendRadius) continue;  // smoothMin is d here, with weight 0
+    float w = 0.0f;
+    d = smoothMin(d, dk, c.blendRadius, &w);
+    grad += w * (nk - grad);
+    if (velocity) vel += w * (pose.parts[k].velocityAt(p) - vel);
+  }
+  if (normal) {
+    // the gradient of a blend of unit normals is shorter than 1, and vanishes only where two
+    // opposite parts blend equally (deep inside): any unit normal will do there
+    const float len = grad.norm();
+    *normal = len > 1e-6f ? Vec3(grad / len) : Vec3(0, 1, 0);
+    if (slope) *slope = len;
+  }
+  if (velocity) *velocity = vel;
+  return d;
 }
 
 }  // namespace
 
-ColliderPose colliderPose(const Collider& c, double t) { return keyframedPose(c.keys, t); }
+bool ColliderPose::moving() const {
+  if (!linearVelocity.isZero() || !angularVelocity.isZero()) return true;
+  return std::any_of(parts.begin(), parts.end(), [](const ColliderPose& q) { return q.moving(); });
+}
+
+Collider makeBodyCollider(const std::string& name, std::vector<Collider> parts, float blendRadius,
+                          const std::string& source) {
+  if (parts.empty()) throw errorAt(source, name, "a body needs at least one part");
+  if (!(blendRadius > 0.0f) || !std::isfinite(blendRadius))
+    throw errorAt(source, name, fmt::format("expected a blend radius > 0 m, got {}", blendRadius));
+  for (const Collider& part : parts)
+    if (part.shape != ColliderShape::Sphere && part.shape != ColliderShape::Capsule && part.shape != ColliderShape::Box)
+      throw errorAt(source, part.name, "expected a sphere, capsule or box as a part of a body");
+  Collider body;
+  body.name = name;
+  body.shape = ColliderShape::Body;
+  body.friction = parts.front().friction;
+  body.staticFriction = parts.front().staticFriction;
+  body.restitution = parts.front().restitution;
+  body.keys = {Keyframe{}};
+  body.blendRadius = blendRadius;
+  body.parts = std::make_shared<const std::vector<Collider>>(std::move(parts));
+  return body;
+}
+
+ColliderPose colliderPose(const Collider& c, double t) { return colliderPose(c, c.keys, t); }
+
+ColliderPose colliderPose(const Collider& c, std::span<const Keyframe> keys, double t) {
+  ColliderPose pose = keyframedPose(keys, t);
+  if (c.shape == ColliderShape::Body && c.parts) {
+    pose.parts.reserve(c.parts->size());
+    for (const Collider& part : *c.parts) pose.parts.push_back(composePose(pose, keyframedPose(part.keys, t)));
+  }
+  return pose;
+}
 
 ColliderPose keyframedPose(std::span<const Keyframe> keys, double t) {
   ColliderPose pose;
@@ -131,11 +216,68 @@ ColliderPose keyframedPose(std::span<const Keyframe> keys, double t) {
 }
 
 float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal) {
+  if (c.shape == ColliderShape::Body) return blendDistance(c, pose, p, normal, nullptr);
   const Vec3 local = pose.rotation.conjugate() * (p - pose.translation);
   Vec3 nLocal;
   const float d = localDistance(c, local, &nLocal);
   if (normal) *normal = pose.rotation * nLocal;
   return d;
+}
+
+bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& x, Vec3* normal) {
+  Vec3 nrm;
+  if (c.shape != ColliderShape::Body) {
+    const float d = colliderDistance(c, pose, x, &nrm) - margin;
+    if (d >= 0.0f) return false;
+    x -= d * nrm;
+    *normal = nrm;
+    return true;
+  }
+  // a Body: the root of s(x + t n) = margin along the start's normal n, bracketed from the Newton
+  // step (margin - s) / |grad s| (doubled until outside) and closed by regula falsi (Illinois); x ends
+  // on the bracket's outside end, so at a distance in [margin, margin + 1e-3 margin] once it converges
+  float slope = 1.0f;
+  const float f0 = blendDistance(c, pose, x, &nrm, nullptr, &slope) - margin;
+  if (f0 >= 0.0f) return false;
+  const auto f = [&](float t) { return colliderDistance(c, pose, x + t * nrm, nullptr) - margin; };
+  float tIn = 0.0f, fIn = f0, tOut = -f0 / std::max(slope, 0.25f), fOut = f(tOut);
+  for (int k = 0; k < kBodyPushes && fOut < 0.0f; ++k) {
+    tIn = tOut, fIn = fOut;
+    tOut *= 2.0f;
+    fOut = f(tOut);
+  }
+  int side = 0;           // Illinois: halve the stale end's value when the same end moves twice
+  float outside = fOut;   // the outside end's true value (fOut may be halved)
+  for (int k = 0; k < 4 * kBodyPushes && outside > 1e-3f * margin; ++k) {
+    const float t = tIn - fIn * (tOut - tIn) / (fOut - fIn);
+    const float ft = f(t);
+    if (ft >= 0.0f) {
+      tOut = t, fOut = outside = ft;
+      if (side == 1) fIn *= 0.5f;
+      side = 1;
+    } else {
+      tIn = t, fIn = ft;
+      if (side == -1) fOut *= 0.5f;
+      side = -1;
+    }
+  }
+  x += tOut * nrm;
+  *normal = nrm;
+  return true;
+}
+
+Vec3 colliderVelocity(const Collider& c, const ColliderPose& pose, const Vec3& p) {
+  if (c.shape != ColliderShape::Body) return pose.velocityAt(p);
+  Vec3 v;
+  blendDistance(c, pose, p, nullptr, &v);
+  return v;
+}
+
+float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3& p) {
+  float speed = pose.velocityAt(p).norm();
+  if (c.shape == ColliderShape::Body)
+    for (const ColliderPose& part : pose.parts) speed = std::max(speed, part.velocityAt(p).norm());
+  return speed;
 }
 
 namespace {
@@ -149,6 +291,83 @@ namespace {
 
 }  // namespace
 
+namespace {
+
+constexpr int64_t kBoundChunk = 256;
+
+// the distances of the `count` points x[3i .. 3i+2] to a plane, sphere, capsule, box or container,
+// without normals, into d[i]: one plain loop per shape (a loop with an inner loop does not vectorise)
+void chunkDistances(const Collider& c, const ColliderPose& pose, const float* x, int64_t count, float* d) {
+  // local = R^T (x - t), R^T as a matrix
+  const Eigen::Matrix3f rt = pose.rotation.normalized().toRotationMatrix().transpose();
+  const float r00 = rt(0, 0), r01 = rt(0, 1), r02 = rt(0, 2), r10 = rt(1, 0), r11 = rt(1, 1), r12 = rt(1, 2),
+              r20 = rt(2, 0), r21 = rt(2, 1), r22 = rt(2, 2);
+  const float tx = pose.translation.x(), ty = pose.translation.y(), tz = pose.translation.z();
+  const float radius = c.radius, halfHeight = c.halfHeight;
+  alignas(64) float lx[kBoundChunk], ly[kBoundChunk], lz[kBoundChunk];
+#pragma omp simd
+  for (int64_t i = 0; i < count; ++i) {
+    const float dx = x[3 * i] - tx, dy = x[3 * i + 1] - ty, dz = x[3 * i + 2] - tz;
+    lx[i] = r00 * dx + r01 * dy + r02 * dz;
+    ly[i] = r10 * dx + r11 * dy + r12 * dz;
+    lz[i] = r20 * dx + r21 * dy + r22 * dz;
+  }
+  if (c.shape == ColliderShape::Plane) {
+#pragma omp simd
+    for (int64_t i = 0; i < count; ++i) d[i] = ly[i];
+  } else if (c.shape == ColliderShape::Sphere) {
+#pragma omp simd
+    for (int64_t i = 0; i < count; ++i) d[i] = std::sqrt(lx[i] * lx[i] + ly[i] * ly[i] + lz[i] * lz[i]) - radius;
+  } else if (c.shape == ColliderShape::Capsule) {
+#pragma omp simd
+    for (int64_t i = 0; i < count; ++i) {
+      const float ay = ly[i] - std::clamp(ly[i], -halfHeight, halfHeight);
+      d[i] = std::sqrt(lx[i] * lx[i] + ay * ay + lz[i] * lz[i]) - radius;
+    }
+  } else {
+    // a box is a container of one wall
+    int walls = 1;
+    Vec3 centers[kContainerWalls] = {Vec3::Zero()}, halves[kContainerWalls] = {c.halfExtents};
+    if (c.shape == ColliderShape::Container) {
+      containerWalls(c, centers, halves);
+      walls = kContainerWalls;
+    }
+    for (int k = 0; k < walls; ++k) {
+      const float ckx = centers[k].x(), cky = centers[k].y(), ckz = centers[k].z();
+      const float hkx = halves[k].x(), hky = halves[k].y(), hkz = halves[k].z();
+      const bool first = k == 0;
+#pragma omp simd
+      for (int64_t i = 0; i < count; ++i) {
+        const float dk = boxSdf(lx[i] - ckx, ly[i] - cky, lz[i] - ckz, hkx, hky, hkz);
+        d[i] = first || dk < d[i] ? dk : d[i];
+      }
+    }
+  }
+}
+
+// a Body's parts folded by smoothMin, as blendDistance does (smoothMin is non-decreasing in both
+// arguments, so parts' lower bounds fold into a lower bound); a Body without its parts' poses is far
+void bodyChunkDistances(const Collider& c, const ColliderPose& pose, const float* x, int64_t count, float* d) {
+  const size_t parts = c.parts ? c.parts->size() : 0;
+  if (parts == 0 || pose.parts.size() != parts) {
+    std::fill(d, d + count, 1.0e30f);
+    return;
+  }
+  chunkDistances((*c.parts)[0], pose.parts[0], x, count, d);
+  alignas(64) float dk[kBoundChunk];
+  const float k = c.blendRadius;
+  for (size_t p = 1; p < parts; ++p) {
+    chunkDistances((*c.parts)[p], pose.parts[p], x, count, dk);
+#pragma omp simd
+    for (int64_t i = 0; i < count; ++i) {
+      float w;
+      d[i] = smoothMin(d[i], dk[i], k, &w);
+    }
+  }
+}
+
+}  // namespace
+
 void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const float* X, int64_t n, float* out) {
   if (c.shape == ColliderShape::Mesh) {
     parallelFor(n, [&](int64_t i) {
@@ -156,63 +375,14 @@ void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const f
     });
     return;
   }
-  // local = R^T (x - t), R^T as a matrix
-  const Eigen::Matrix3f rt = pose.rotation.normalized().toRotationMatrix().transpose();
-  const float r00 = rt(0, 0), r01 = rt(0, 1), r02 = rt(0, 2), r10 = rt(1, 0), r11 = rt(1, 1), r12 = rt(1, 2),
-              r20 = rt(2, 0), r21 = rt(2, 1), r22 = rt(2, 2);
-  const float tx = pose.translation.x(), ty = pose.translation.y(), tz = pose.translation.z();
-  const ColliderShape shape = c.shape;
-  const float radius = c.radius, halfHeight = c.halfHeight;
-  // a box is a container of one wall
-  int walls = 1;
-  float cx[kContainerWalls] = {}, cy[kContainerWalls] = {}, cz[kContainerWalls] = {};
-  float hx[kContainerWalls] = {c.halfExtents.x()}, hy[kContainerWalls] = {c.halfExtents.y()},
-        hz[kContainerWalls] = {c.halfExtents.z()};
-  if (shape == ColliderShape::Container) {
-    Vec3 centers[kContainerWalls], halves[kContainerWalls];
-    containerWalls(c, centers, halves);
-    walls = kContainerWalls;
-    for (int k = 0; k < walls; ++k)
-      cx[k] = centers[k].x(), cy[k] = centers[k].y(), cz[k] = centers[k].z(), hx[k] = halves[k].x(),
-      hy[k] = halves[k].y(), hz[k] = halves[k].z();
-  }
-  constexpr int64_t kChunk = 256;
-  parallelFor((n + kChunk - 1) / kChunk, [&](int64_t chunk) {
-    const int64_t begin = chunk * kChunk, count = std::min(n, begin + kChunk) - begin;
-    const float* const x = X + 3 * begin;
+  parallelFor((n + kBoundChunk - 1) / kBoundChunk, [&](int64_t chunk) {
+    const int64_t begin = chunk * kBoundChunk, count = std::min(n, begin + kBoundChunk) - begin;
+    alignas(64) float d[kBoundChunk];
+    if (c.shape == ColliderShape::Body)
+      bodyChunkDistances(c, pose, X + 3 * begin, count, d);
+    else
+      chunkDistances(c, pose, X + 3 * begin, count, d);
     float* const o = out + begin;
-    // one plain loop per shape (a loop with an inner loop does not vectorise)
-    alignas(64) float lx[kChunk], ly[kChunk], lz[kChunk], d[kChunk];
-#pragma omp simd
-    for (int64_t i = 0; i < count; ++i) {
-      const float dx = x[3 * i] - tx, dy = x[3 * i + 1] - ty, dz = x[3 * i + 2] - tz;
-      lx[i] = r00 * dx + r01 * dy + r02 * dz;
-      ly[i] = r10 * dx + r11 * dy + r12 * dz;
-      lz[i] = r20 * dx + r21 * dy + r22 * dz;
-    }
-    if (shape == ColliderShape::Plane) {
-#pragma omp simd
-      for (int64_t i = 0; i < count; ++i) d[i] = ly[i];
-    } else if (shape == ColliderShape::Sphere) {
-#pragma omp simd
-      for (int64_t i = 0; i < count; ++i) d[i] = std::sqrt(lx[i] * lx[i] + ly[i] * ly[i] + lz[i] * lz[i]) - radius;
-    } else if (shape == ColliderShape::Capsule) {
-#pragma omp simd
-      for (int64_t i = 0; i < count; ++i) {
-        const float ay = ly[i] - std::clamp(ly[i], -halfHeight, halfHeight);
-        d[i] = std::sqrt(lx[i] * lx[i] + ay * ay + lz[i] * lz[i]) - radius;
-      }
-    } else {
-      for (int k = 0; k < walls; ++k) {
-        const float ckx = cx[k], cky = cy[k], ckz = cz[k], hkx = hx[k], hky = hy[k], hkz = hz[k];
-        const bool first = k == 0;
-#pragma omp simd
-        for (int64_t i = 0; i < count; ++i) {
-          const float dk = boxSdf(lx[i] - ckx, ly[i] - cky, lz[i] - ckz, hkx, hky, hkz);
-          d[i] = first || dk < d[i] ? dk : d[i];
-        }
-      }
-    }
 #pragma omp simd
     for (int64_t i = 0; i < count; ++i) {
       const float v = d[i] - kDistanceBoundSlack;

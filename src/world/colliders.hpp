@@ -1,4 +1,5 @@
-// rigid colliders (plane, box, open container, sphere, capsule, mesh) with kinematic keyframed motion;
+// colliders (plane, box, open container, sphere, capsule, mesh, and a body: a smooth union of parts
+// that move on their own) with kinematic keyframed motion;
 // contact with Coulomb friction and restitution (collider_contact.cpp). Shared by both cloth solvers and the water.
 #pragma once
 #include <soak/model.hpp>
@@ -7,6 +8,7 @@
 #include "core/parallel.hpp"
 
 #include <span>
+#include <string>
 #include <vector>
 
 namespace soak {
@@ -18,21 +20,51 @@ struct ColliderPose {
   Vec3 linearVelocity{0, 0, 0};   // m/s of the local origin
   Vec3 angularVelocity{0, 0, 0};  // rad/s, world frame
   Vec3 velocityAt(const Vec3& p) const { return linearVelocity + angularVelocity.cross(p - translation); }
+  // a Body collider: the world pose of each of its parts (the body's pose composed with the part's)
+  std::vector<ColliderPose> parts;
+  bool moving() const;  // a velocity, its own or a part's, is not zero
 };
 
 // pose at time t: translation interpolated linearly between keyframes, rotation by slerp, the ends
 // held; velocities from the keyframe segment containing t
 ColliderPose colliderPose(const Collider& c, double t);
+// the same with the collider's keys replaced by `keys` (a Body's parts keep theirs, relative to them)
+ColliderPose colliderPose(const Collider& c, std::span<const Keyframe> keys, double t);
 // the same for keyframes given apart from a collider (a caller's, step.hpp)
 ColliderPose keyframedPose(std::span<const Keyframe> keys, double t);
 
 // signed distance (m, negative inside the solid) from world point p to the collider, and the unit
-// outward normal of the nearest surface in `normal` (world frame)
+// outward normal of the nearest surface in `normal` (world frame). A Body blends its parts' distances
+// by smoothMin (world/smooth_min.hpp), its normal is the blend's normalised gradient; a Body pose
+// without its parts' poses (not from colliderPose) is far from everything
 float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal);
+
+// moves x out along the collider's normal to a distance >= margin; true when x was within the margin,
+// *normal the last push's normal. One push for the exact distances; a Body's smooth distance changes
+// by |gradient| <= 1 per metre moved, so a push by the distance falls short where parts blend: its
+// push is found along the normal by a bracketed root search (kBodyPushes doublings, 4 kBodyPushes
+// regula falsi steps at most) and ends within 1e-3 margin beyond the margin
+constexpr int kBodyPushes = 4;
+bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& x, Vec3* normal);
+
+// velocity (m/s) of the collider's surface material at world point p: the rigid field of the pose,
+// or for a Body its parts' fields blended with the weights of its normal (a point of the skin between
+// two bones moves as a mix of both)
+Vec3 colliderVelocity(const Collider& c, const ColliderPose& pose, const Vec3& p);
+// an upper bound of |colliderVelocity(c, pose, p)| that costs no distance (a Body: its fastest part)
+float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3& p);
+
+// a Body collider joining `parts` (sphere, capsule or box colliders, their keys in the body's frame)
+// by smoothMin of radius blendRadius (m); it rests at the identity (one key) and takes the first
+// part's friction and restitution. Throws soak::Error naming `source` on another part shape, no parts
+// or a radius that is not > 0
+Collider makeBodyCollider(const std::string& name, std::vector<Collider> parts, float blendRadius,
+                          const std::string& source);
 
 // a lower bound of colliderDistance(c, pose, x_i) for the n points x_i = X[3i .. 3i+2], min-ed into
 // out[i] (out[i] = min(out[i], bound)): exact up to kDistanceBoundSlack for planes, spheres, capsules,
-// boxes and containers, in a vectorised loop without normals; a mesh collider gets its exact distance.
+// boxes, containers and bodies, in a vectorised loop without normals; a mesh collider gets its exact
+// distance.
 // For skipping the points that cannot be within some distance of the collider
 constexpr float kDistanceBoundSlack = 1e-4f;  // m, covers the rounding of the matrix against the quaternion
 void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const float* X, int64_t n, float* out);

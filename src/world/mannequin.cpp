@@ -3,6 +3,8 @@
 // fixed interval, so each part's keys follow the joint chain (linear keys between samples).
 #include "world/mannequin.hpp"
 
+#include "world/colliders.hpp"
+
 #include <soak/error.hpp>
 
 #include <cmath>
@@ -149,6 +151,8 @@ void checkParams(const MannequinParams& mp, const std::vector<PoseKey>& keys, co
   for (const auto& [name, value] : fractions)
     if (!(value > 0.0f && value < 0.5f))
       throw errorAt(source, where + "." + name, "must be a fraction of the height in (0, 0.5)");
+  if (!(mp.blend >= 0.0f && mp.blend <= 0.1f))
+    throw errorAt(source, where + ".blend", "must be a fraction of the height in [0, 0.1]");
   if (!(mp.sampleInterval > 0.0f)) throw errorAt(source, where + ".sampleInterval", "must be > 0 s");
   for (size_t k = 1; k < keys.size(); ++k)
     if (!(keys[k].time >= keys[k - 1].time))
@@ -246,6 +250,13 @@ std::vector<Collider> buildMannequin(const MannequinParams& params, const std::v
     }
   }
   return colliders;
+}
+
+std::vector<Collider> mannequinColliders(const MannequinParams& params, const std::vector<PoseKey>& keys,
+                                         float friction, const std::string& prefix, const std::string& source) {
+  std::vector<Collider> parts = buildMannequin(params, keys, friction, prefix, source);
+  if (params.blend == 0.0f) return parts;
+  return {makeBodyCollider(prefix, std::move(parts), params.blend * params.height, source)};
 }
 
 }  // namespace soak

@@ -49,6 +49,7 @@ struct MannequinParams {
   float shankRadius = 0.032f;
   float footRadius = 0.025f;
   float sampleInterval = 1.0f / 30.0f;  // s between generated collider keys of a motion
+  float blend = 0.02f;           // radius of the smooth union of the parts / height (0.035 m); 0: separate parts
 };
 
 // the world positions of the joints of a posed body (m), for tests, garments and users
@@ -68,6 +69,13 @@ MannequinJoints mannequinJoints(const MannequinParams& params, const MannequinPo
 // radius, or keys out of order.
 std::vector<Collider> buildMannequin(const MannequinParams& params, const std::vector<PoseKey>& keys, float friction,
                                      const std::string& prefix = "mannequin", const std::string& source = "mannequin");
+
+// the body as a scene holds it: with params.blend > 0 one Body collider named `prefix` whose parts are
+// buildMannequin's colliders joined by a smooth minimum of radius blend * height (a smooth skin that
+// the joints move), else buildMannequin's separate parts. Throws as buildMannequin does, and on a
+// blend outside [0, 0.1]
+std::vector<Collider> mannequinColliders(const MannequinParams& params, const std::vector<PoseKey>& keys,
+                                         float friction, const std::string& prefix, const std::string& source);
 
 // the pose at time t of a key list (linear between keys, ends held); params.pose when empty
 MannequinPose poseAt(const MannequinParams& params, const std::vector<PoseKey>& keys, double t);

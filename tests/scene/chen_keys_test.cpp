@@ -35,10 +35,18 @@ TEST(GarmentScene, KeysReachTheModel) {
                            "wrinkles": {"interval": 5}}}],
     "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [0.5, 0.3], "rate": 100}]})");
   const Model& m = s.model;
-  ASSERT_EQ(m.colliders.size(), 18u);
-  EXPECT_EQ(m.colliders.front().name, "body.head");
-  EXPECT_EQ(m.colliders.back().name, "body.foot_r");
-  EXPECT_FLOAT_EQ(m.colliders[3].friction, 0.4f);
+  // one smooth body of 18 parts, blended over 0.02 of its height (the default)
+  ASSERT_EQ(m.colliders.size(), 1u);
+  const Collider& body = m.colliders[0];
+  EXPECT_EQ(body.name, "body");
+  EXPECT_EQ(body.shape, ColliderShape::Body);
+  EXPECT_FLOAT_EQ(body.blendRadius, 0.02f * 1.6f);
+  EXPECT_FLOAT_EQ(body.friction, 0.4f);
+  ASSERT_TRUE(body.parts);
+  ASSERT_EQ(body.parts->size(), 18u);
+  EXPECT_EQ(body.parts->front().name, "body.head");
+  EXPECT_EQ(body.parts->back().name, "body.foot_r");
+  EXPECT_FLOAT_EQ((*body.parts)[3].friction, 0.4f);
   ASSERT_EQ(m.pieces.size(), 1u);
   const ClothPiece& p = m.pieces[0];
   EXPECT_EQ(p.solver, ClothSolver::Implicit);
@@ -63,9 +71,8 @@ TEST(GarmentScene, KeysReachTheModel) {
   EXPECT_EQ(m.emitters[0].kind, EmitterKind::Rain);
   EXPECT_FLOAT_EQ(m.emitters[0].halfExtents.z(), 0.3f);
   // the garment starts outside the body by its margin
-  const std::vector<Collider> body(m.colliders.begin(), m.colliders.end());
   for (int i = 0; i < m.numCloth; ++i)
-    EXPECT_GE(bodyDistance(body, 0.0, s.state.particles.x[size_t(i)], nullptr), 0.0099f) << i;
+    EXPECT_GE(bodyDistance(m.colliders, 0.0, s.state.particles.x[size_t(i)], nullptr), 0.0099f) << i;
 }
 
 TEST(GarmentScene, MannequinPoseKeyframesAnimateItsColliders) {
@@ -74,20 +81,28 @@ TEST(GarmentScene, MannequinPoseKeyframesAnimateItsColliders) {
                    "keyframes": [{"time": 0, "pose": {"shoulderAbduction": [45, 45]}},
                                  {"time": 1, "pose": {"shoulderAbduction": [45, 45], "elbowFlexion": [90, 0]}}]}],
     "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [0.5, 0.5]}]})");
-  const std::vector<Collider>& c = s.model.colliders;
-  const auto find = [&](const std::string& name) -> const Collider& {
-    for (const Collider& x : c)
-      if (x.name == name) return x;
-    throw Error("no collider " + name);
+  ASSERT_EQ(s.model.colliders.size(), 1u);
+  const Collider& body = s.model.colliders[0];
+  ASSERT_TRUE(body.parts);
+  const std::vector<Collider>& c = *body.parts;
+  const auto find = [&](const std::string& name) -> size_t {
+    for (size_t k = 0; k < c.size(); ++k)
+      if (c[k].name == name) return k;
+    throw Error("no part " + name);
   };
-  const Collider& left = find("body.hand_l");
-  const Collider& right = find("body.hand_r");
-  EXPECT_GT(left.keys.size(), 20u);  // sampled every 1/30 s
-  const Vec3 l0 = colliderPose(left, 0.0).translation, l1 = colliderPose(left, 1.0).translation;
-  const Vec3 r0 = colliderPose(right, 0.0).translation, r1 = colliderPose(right, 1.0).translation;
+  const size_t left = find("body.hand_l"), right = find("body.hand_r");
+  EXPECT_GT(c[left].keys.size(), 20u);  // sampled every 1/30 s
+  const ColliderPose p0 = colliderPose(body, 0.0), p1 = colliderPose(body, 1.0);
+  const Vec3 l0 = p0.parts[left].translation, l1 = p1.parts[left].translation;
+  const Vec3 r0 = p0.parts[right].translation, r1 = p1.parts[right].translation;
   EXPECT_GT((l1 - l0).norm(), 0.1f);   // the bent left elbow brings the hand forward
   EXPECT_GT(l1.z(), l0.z() + 0.1f);
   EXPECT_LT((r1 - r0).norm(), 1e-4f);  // the right arm keeps its pose
+  // the skin moves with the hand: the body's surface velocity at the left hand is the hand's
+  const ColliderPose mid = colliderPose(body, 0.5);
+  const Vec3 onHand = mid.parts[left].translation + Vec3(c[left].radius, 0, 0);
+  EXPECT_LT((colliderVelocity(body, mid, onHand) - mid.parts[left].velocityAt(onHand)).norm(), 1e-5f);
+  EXPECT_GT(mid.parts[left].velocityAt(onHand).norm(), 0.1f);
   EXPECT_HAS(loadError(R"({"colliders": [{"name": "b", "type": "mannequin", "pose": {},
                                           "keyframes": [{"time": 0, "pose": {}}]}],
                            "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [1, 1]}]})"),
@@ -358,10 +373,18 @@ TEST(ChenKeys, MannequinProportionsAndForeignKeys) {
     "emitters": [{"type": "rain", "origin": [0, 2, 0], "halfExtents": [1, 1]}]})";
   const Scene s = fromString(body);
   const Collider* head = nullptr;
-  for (const Collider& c : s.model.colliders)
+  ASSERT_EQ(s.model.colliders.size(), 1u);
+  for (const Collider& c : *s.model.colliders[0].parts)
     if (c.name == "body.head") head = &c;
   ASSERT_NE(head, nullptr);
   EXPECT_FLOAT_EQ(head->radius, 0.08f * 1.6f);
+  // blend 0: the parts as separate colliders
+  const Scene parts = fromString(body, {"colliders.0.blend=0"});
+  ASSERT_EQ(parts.model.colliders.size(), 18u);
+  EXPECT_EQ(parts.model.colliders.front().name, "body.head");
+  EXPECT_EQ(parts.model.colliders.front().shape, ColliderShape::Sphere);
+  EXPECT_FLOAT_EQ(fromString(body, {"colliders.0.blend=0.05"}).model.colliders[0].blendRadius, 0.05f * 1.6f);
+  EXPECT_HAS(loadError(body, {"colliders.0.blend=0.2"}), "at colliders[0].blend: expected a number in [0, 0.1], got 0.2");
   EXPECT_HAS(loadError(body, {"colliders.0.proportions.headRadius=0"}),
              "at colliders[0].proportions.headRadius: expected a number in (0, 1], got 0");
   EXPECT_HAS(loadError(body, {"colliders.0.proportions.neck=0.1"}), "at colliders[0].proportions.neck: unknown key 'neck'");
