@@ -239,6 +239,16 @@ TEST(BodyCollider, MannequinSkinWrapsItsParts) {
     blended += d < nearest - 1e-4f ? 1 : 0;
   }
   EXPECT_GT(blended, 100);  // the blend is not confined to a few points
+  // blend 0: the separate parts; out of [0, 0.1]: refused, naming the key
+  mp.blend = 0.0f;
+  EXPECT_EQ(mannequinColliders(mp, keys, 0.5f, "m", "test").size(), parts.size());
+  mp.blend = 0.2f;
+  try {
+    mannequinColliders(mp, keys, 0.5f, "m", "scene.json");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mannequin.blend"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
