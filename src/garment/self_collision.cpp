@@ -6,6 +6,31 @@
 
 namespace soak {
 
+namespace {
+
+// whether the vertex, from signed distance dist0 at the start to dist1 at the end (opposite signs),
+// crossed the triangle's plane inside the triangle: at the fraction s = dist0 / (dist0 - dist1) of the
+// step, all four points moved linearly, its projection on the triangle then has barycentric
+// coordinates >= -kCrossingSlack. A vertex that went round the triangle's edge (a fold sliding over
+// itself) crossed the plane outside it and is on its new side legitimately
+constexpr float kCrossingSlack = 0.1f;
+bool crossedInside(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float dist0, float dist1) {
+  const float s = dist0 / (dist0 - dist1);
+  std::array<Vec3, 4> xs;
+  for (int k = 0; k < 4; ++k) xs[k] = x0[k] + s * (x1[k] - x0[k]);
+  const Vec3 nraw = (xs[2] - xs[1]).cross(xs[3] - xs[1]);
+  const float area2 = nraw.squaredNorm();
+  if (!(area2 > 1e-24f)) return true;  // degenerate at the crossing: keep the start's side
+  for (int k = 1; k <= 3; ++k) {
+    const Vec3& u = xs[k % 3 + 1];
+    const Vec3& t = xs[(k + 1) % 3 + 1];
+    if ((u - xs[0]).cross(t - xs[0]).dot(nraw) / area2 < -kCrossingSlack) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
                            const std::array<float, 4>& w, float d) {
   const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
@@ -20,7 +45,9 @@ bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x
   if (n0.dot(n1) < 0.5f) return false;
   const float dist0 = (x0[0] - x0[1]).dot(n0);
   // the side the vertex started on; a vertex that started in the plane keeps the side it ends on
-  const float side = std::abs(dist0) > 1e-7f ? (dist0 > 0.0f ? 1.0f : -1.0f) : (dist1 >= 0.0f ? 1.0f : -1.0f);
+  float side = std::abs(dist0) > 1e-7f ? (dist0 > 0.0f ? 1.0f : -1.0f) : (dist1 >= 0.0f ? 1.0f : -1.0f);
+  // ended on the other side: put back only if it went through the triangle, not round its edge
+  if (side * dist1 < 0.0f && !crossedInside(x0, x1, dist0, dist1)) side = -side;
   if (side * dist1 >= d) return false;
   // barycentric coordinates of the vertex's projection on the triangle's plane at the end
   const Vec3 q = x1[0] - dist1 * n1;

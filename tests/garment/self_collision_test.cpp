@@ -58,6 +58,22 @@ TEST(GarmentSelfCollision, AFlippedTriangleDoesNotPushAVertexThrough) {
   EXPECT_GT(moved[0].z(), 0.005f);
 }
 
+// a vertex that went round the triangle's edge (from above and beside it to under it, as a fold
+// sliding over itself does) crossed the plane outside the triangle: it is on its new side by right,
+// kept there (pushed to the thickness below), not pushed up through the triangle
+TEST(GarmentSelfCollision, AVertexThatWentRoundTheEdgeKeepsItsNewSide) {
+  const std::array<float, 4> w = {1.0f, 1.0f, 1.0f, 1.0f};
+  std::array<Vec3, 4> v{};
+  const std::array<Vec3, 4> x0 = {Vec3(-0.3f, 0.25f, 0.001f), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  std::array<Vec3, 4> x1 = startAbove(-0.003f);
+  ASSERT_TRUE(pushVertexOffTriangle(x0, x1, v, w, 0.008f));
+  EXPECT_LT(x1[0].z() - x1[1].z(), -0.0079f);  // below, at the thickness
+  // the same end reached straight through the triangle is put back above it
+  std::array<Vec3, 4> through = startAbove(-0.003f);
+  ASSERT_TRUE(pushVertexOffTriangle(startAbove(0.01f), through, v, w, 0.008f));
+  EXPECT_GT(through[0].z() - through[1].z(), 0.0079f);
+}
+
 TEST(GarmentSelfCollision, ASheetDroppedOnAnotherStaysOnIt) {
   // two 2 x 2 quads of the same piece: the upper one's vertices fall through the lower one's plane
   Particles p;
