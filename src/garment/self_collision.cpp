@@ -8,6 +8,8 @@ namespace soak {
 
 namespace {
 
+constexpr float kMaxPushes = 1.0f;  // thicknesses
+
 // whether the vertex, from signed distance dist0 at the start to dist1 at the end (opposite signs),
 // crossed the triangle's plane inside the triangle: at the fraction s = dist0 / (dist0 - dist1) of the
 // step, all four points moved linearly, its projection on the triangle then has barycentric
@@ -60,7 +62,11 @@ bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x
   }
   const float denom = w[0] + b[1] * b[1] * w[1] + b[2] * b[2] * w[2] + b[3] * b[3] * w[3];
   if (!(denom > 0.0f)) return false;
-  const float push = (side * d - dist1) / denom;  // along n1, shared by inverse mass and weight
+  // the gap to close, at most kMaxPushes thicknesses a push: a deeper crossing closes over the passes
+  // and steps, and no single push stretches the springs around it by more than that (uncapped, the
+  // pushes' spring energy fed faster motion and more pushes until the Fig. 9 shirt diverged)
+  const float gap = std::clamp(side * d - dist1, -kMaxPushes * d, kMaxPushes * d);
+  const float push = gap / denom;  // along n1, shared by inverse mass and weight
   x1[0] += w[0] * push * n1;
   for (int k = 1; k <= 3; ++k) x1[k] -= b[k] * w[k] * push * n1;
   Vec3 rel = v[0];
