@@ -75,7 +75,8 @@ void updateColliderPoses(const Model& model, double time, std::span<const std::v
   poses.resize(model.colliders.size());
   for (size_t c = 0; c < model.colliders.size(); ++c) {
     const bool given = c < colliderKeys.size() && !colliderKeys[c].empty();
-    poses[c] = colliderPose(model.colliders[c], given ? std::span<const Keyframe>(colliderKeys[c]) : model.colliders[c].keys, time);
+    const std::span<const Keyframe> keys = given ? colliderKeys[c] : model.colliders[c].keys;
+    poses[c] = colliderPose(model.colliders[c], keys, time);
   }
 }
 

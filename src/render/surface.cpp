@@ -217,7 +217,8 @@ SurfaceMesh colliderSurfaceMesh(const Collider& c, const ColliderPose& pose, con
   if (nodes > kMaxSdfNodes) return {};
   std::vector<float> points(size_t(3 * nodes));
   for (int64_t n = 0; n < nodes; ++n) {
-    const int64_t i = n % sdf.dims[0], j = (n / sdf.dims[0]) % sdf.dims[1], k = n / (int64_t(sdf.dims[0]) * sdf.dims[1]);
+    const int64_t i = n % sdf.dims[0], j = (n / sdf.dims[0]) % sdf.dims[1];
+    const int64_t k = n / (int64_t(sdf.dims[0]) * sdf.dims[1]);
     const Vec3 x = sdf.origin + cellSize * Vec3(float(i), float(j), float(k));
     std::copy(x.data(), x.data() + 3, points.begin() + 3 * n);
   }

@@ -115,8 +115,8 @@ struct ContactResult {
 // on; one found inside: out along the nearest normal), then Coulomb friction acts on its slip
 // relative to the surface. `repeat`: a later pass over the parts, which only pushes out what the
 // other parts pushed in (the friction of this substep's contacts has acted)
-ContactResult contactWith(const ContactPart& part, const Collider& owner, const ColliderPose& ownerPose, const Vec3& x, Vec3& xp,
-                          float margin, float dt, FrictionCoefficients mu, bool repeat, Vec3* normal) {
+ContactResult contactWith(const ContactPart& part, const Collider& owner, const ColliderPose& ownerPose, const Vec3& x,
+                          Vec3& xp, float margin, float dt, FrictionCoefficients mu, bool repeat, Vec3* normal) {
   ContactResult r;
   Vec3 nrm;
   const float rawEnd = colliderDistance(part.shape, part.pose, xp, &nrm);
@@ -151,7 +151,8 @@ ContactResult contactWith(const ContactPart& part, const Collider& owner, const 
   const float after = colliderDistance(part.shape, part.pose, xp, &n0);
   if (after < margin - 1e-6f) {
     xp -= (after - margin) * n0;
-    if (part.shape.shape == ColliderShape::Body) pushOutOf(part.shape, part.pose, margin - 1e-6f, xp, &n0);  // one push may fall short
+    // a Body's push by the distance may fall short where its parts blend
+    if (part.shape.shape == ColliderShape::Body) pushOutOf(part.shape, part.pose, margin - 1e-6f, xp, &n0);
   }
   if (!repeat) {
     const Vec3 slip = (xp - x) - colliderVelocity(owner, ownerPose, xp) * dt;  // motion relative to the surface
@@ -210,9 +211,9 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
       size_t lastPush = 0;
       for (size_t k = 0; k < end; ++k) {
         const ContactPart& part = parts[k];
-        const ContactResult r = contactWith(part, model.colliders[part.owner], poses[part.owner], p.x[i], xp, margin, dt,
-                                            frictionOf(model, model.colliders[part.owner], p.phase[i]), pass > 0,
-                                            &contactNormal[i]);
+        const Collider& owner = model.colliders[part.owner];
+        const ContactResult r = contactWith(part, owner, poses[part.owner], p.x[i], xp, margin, dt,
+                                            frictionOf(model, owner, p.phase[i]), pass > 0, &contactNormal[i]);
         caught += r.putBack ? 1 : 0;
         if (r.touched) lastPush = k;
       }

@@ -491,7 +491,8 @@ float deepestBetweenVertices(const Scene& s) {
 TEST(GarmentRun, EdgeContactKeepsTheBodyOutOfTheEdgesAndTriangles) {
   const std::string path = std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_dry.json";
   Scene off = loadScene(path, {"cloth.0.mesh.edgeLength=0.045", "colliders.0.blend=0"});
-  Scene on = loadScene(path, {"cloth.0.mesh.edgeLength=0.045", "colliders.0.blend=0", "cloth.0.garment.edgeContact=true"});
+  Scene on = loadScene(path,
+                       {"cloth.0.mesh.edgeLength=0.045", "colliders.0.blend=0", "cloth.0.garment.edgeContact=true"});
   StepStats total;
   run(off.model, off.state, 60);  // 1 s
   run(on.model, on.state, 60, &total);

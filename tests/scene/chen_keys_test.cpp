@@ -384,7 +384,8 @@ TEST(ChenKeys, MannequinProportionsAndForeignKeys) {
   EXPECT_EQ(parts.model.colliders.front().name, "body.head");
   EXPECT_EQ(parts.model.colliders.front().shape, ColliderShape::Sphere);
   EXPECT_FLOAT_EQ(fromString(body, {"colliders.0.blend=0.05"}).model.colliders[0].blendRadius, 0.05f * 1.6f);
-  EXPECT_HAS(loadError(body, {"colliders.0.blend=0.2"}), "at colliders[0].blend: expected a number in [0, 0.1], got 0.2");
+  EXPECT_HAS(loadError(body, {"colliders.0.blend=0.2"}),
+             "at colliders[0].blend: expected a number in [0, 0.1], got 0.2");
   EXPECT_HAS(loadError(body, {"colliders.0.proportions.headRadius=0"}),
              "at colliders[0].proportions.headRadius: expected a number in (0, 1], got 0");
   EXPECT_HAS(loadError(body, {"colliders.0.proportions.neck=0.1"}), "at colliders[0].proportions.neck: unknown key 'neck'");
