@@ -154,12 +154,13 @@ std::vector<float> clothWetness(const Model& model, const State& state) {
 GarmentShape garmentShape(const Model& model, const State& state) {
   GarmentShape g;
   const std::vector<float> wet = clothWetness(model, state);
-  double lowest = std::numeric_limits<double>::infinity(), distance = 0.0, saturation = 0.0;
+  double lowest = std::numeric_limits<double>::infinity(), height = 0.0, distance = 0.0, saturation = 0.0;
   for (const ClothPiece& piece : model.pieces) {
     if (piece.solver != ClothSolver::Implicit && !piece.wetByContact) continue;
     for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
       const Vec3& x = state.particles.x[size_t(i)];
       lowest = std::min(lowest, double(x.y()));
+      height += x.y();
       if (!model.colliders.empty()) distance += bodyDistance(model.colliders, state.time, x, nullptr);
       saturation += wet[size_t(i)];
       ++g.vertices;
@@ -167,6 +168,7 @@ GarmentShape garmentShape(const Model& model, const State& state) {
   }
   if (g.vertices == 0) return g;
   g.lowest = lowest;
+  g.meanHeight = height / g.vertices;
   g.meanColliderDistance = distance / g.vertices;
   g.meanSaturation = saturation / g.vertices;
   return g;

@@ -61,11 +61,11 @@ size_t wetClothByContact(const Model& model, State& state, const NeighborLists& 
 std::vector<float> clothWetness(const Model& model, const State& state);
 
 // how a garment sits, for the statistics: over the vertices of the pieces solved implicitly or
-// wetted by contact, the lowest height (m), the mean distance to the nearest collider's surface (m;
-// 0 without colliders) and the mean saturation in [0, 1] (clothWetness)
+// wetted by contact, the lowest and the mean height (m), the mean distance to the nearest collider's
+// surface (m; 0 without colliders) and the mean saturation in [0, 1] (clothWetness)
 struct GarmentShape {
   int vertices = 0;
-  double lowest = 0.0, meanColliderDistance = 0.0, meanSaturation = 0.0;
+  double lowest = 0.0, meanHeight = 0.0, meanColliderDistance = 0.0, meanSaturation = 0.0;
 };
 GarmentShape garmentShape(const Model& model, const State& state);
 

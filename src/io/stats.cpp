@@ -96,6 +96,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
     const GarmentShape shape = garmentShape(model, state);  // how it hangs: wet against dry
     if (shape.vertices > 0) {
       j["garment"]["lowestPoint"] = shape.lowest;
+      j["garment"]["meanHeight"] = shape.meanHeight;
       j["garment"]["meanSaturation"] = shape.meanSaturation;
       if (!model.colliders.empty()) j["garment"]["meanColliderDistance"] = shape.meanColliderDistance;
     }

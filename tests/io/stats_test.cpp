@@ -193,10 +193,11 @@ TEST(IoStats, GarmentShapeOfTheWettedPieces) {
   f.state.clothSaturation[11] = 1.0f;  // the patch's
   Particles& p = f.state.particles;
   p.x[4].y() -= 0.25f;
-  double lowest = 1e30;
-  for (int i = 0; i < 9; ++i) lowest = std::min(lowest, double(p.x[size_t(i)].y()));
+  double lowest = 1e30, height = 0.0;
+  for (int i = 0; i < 9; ++i) lowest = std::min(lowest, double(p.x[size_t(i)].y())), height += p.x[size_t(i)].y();
   auto j = frameStatsJson(f.model, f.state, 0, FrameStats{});
   EXPECT_DOUBLE_EQ(j["garment"]["lowestPoint"].get<double>(), lowest);
+  EXPECT_NEAR(j["garment"]["meanHeight"].get<double>(), height / 9.0, 1e-7);
   EXPECT_NEAR(j["garment"]["meanSaturation"].get<double>(), 0.1, 1e-7);
   EXPECT_FALSE(j["garment"].contains("meanColliderDistance"));
   Collider ball;

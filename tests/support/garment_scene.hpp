@@ -52,10 +52,4 @@ inline void run(const Model& model, State& state, int steps, StepStats* total = 
   }
 }
 
-inline double meanHeight(const Model& model, const State& state) {
-  double y = 0.0;
-  for (int i = 0; i < model.numCloth; ++i) y += state.particles.x[size_t(i)].y();
-  return y / model.numCloth;
-}
-
 }  // namespace soak::testing
