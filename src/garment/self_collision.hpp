@@ -2,7 +2,8 @@
 // body contact, every free vertex is kept at least the cloth's thickness away from every triangle of
 // its piece that does not hold it (or a vertex seamed to it), on the side it was at the start of the
 // step, so a vertex that passed through a triangle during the step is put back (proximity with the
-// start-of-step side, after Bridson, Fedkiw and Anderson 2002). Edge-edge proximity is not tested:
+// start-of-step side, after Bridson, Fedkiw and Anderson 2002); one that crossed the plane outside
+// the triangle (round its edge) keeps its new side, and a push closes at most one thickness. Edge-edge proximity is not tested:
 // two edges can still pass through each other between the vertices. The push is shared by the vertex and
 // the triangle's three vertices by inverse mass and barycentric weight (momentum is kept), and their
 // velocity towards each other along the triangle's normal is removed (inelastic). Gauss-Seidel over

@@ -133,7 +133,8 @@ float blendDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, 
   }
   if (normal) {
     // the gradient of a blend of unit normals is shorter than 1, and vanishes only where two
-    // opposite parts blend equally (deep inside): any unit normal will do there
+    // opposite normals blend equally (deep inside, or midway across a gap narrower than the blend
+    // radius): any unit normal will do there
     const float len = grad.norm();
     *normal = len > 1e-6f ? Vec3(grad / len) : Vec3(0, 1, 0);
     if (slope) *slope = len;
