@@ -270,10 +270,9 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
     if (!ma && !mb) continue;
     for (size_t c = 0; c < numColliders; ++c) {
       const Vec3 mid = 0.5f * (x[a] + x[b]);
-      Vec3 nrm;
-      const float d = colliderDistance(model.colliders[c], poses[c], mid, &nrm) - margin;
-      if (d >= 0.0f) continue;
-      const Vec3 push = -d * nrm * (ma && mb ? 1.0f : 2.0f);
+      Vec3 nrm, out = mid;
+      if (!pushOutOf(model.colliders[c], poses[c], margin, out, &nrm)) continue;  // the midpoint's push
+      const Vec3 push = (out - mid) * (ma && mb ? 1.0f : 2.0f);
       for (const auto& [u, free] : {std::pair{a, ma}, std::pair{b, mb}}) {
         if (!free) continue;
         x[u] += push;

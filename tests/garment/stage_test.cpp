@@ -501,6 +501,10 @@ TEST(GarmentRun, EdgeContactKeepsTheBodyOutOfTheEdgesAndTriangles) {
   EXPECT_GT(total.garment.edgeContacts, 0u);
   for (int i = 0; i < on.model.numCloth; ++i)
     EXPECT_GT(bodyDistance(on.model.colliders, on.state.time, on.state.particles.x[size_t(i)], nullptr), -thickness);
+  // on the smooth skin too (its midpoints pushed by the root search where the parts blend)
+  Scene smooth = loadScene(path, {"cloth.0.mesh.edgeLength=0.045", "cloth.0.garment.edgeContact=true"});
+  run(smooth.model, smooth.state, 60);
+  EXPECT_GT(deepestBetweenVertices(smooth), -0.25f * thickness);
 }
 
 TEST(GarmentRun, SameStateForOneAndTwoThreads) {
