@@ -146,14 +146,10 @@ ContactResult contactWith(const ContactPart& part, const Collider& owner, const 
     r.putBack = true;  // found inside: out along the nearest normal
   }
   xp -= d * nrm;
-  // still within the margin (a concave mesh, or a box's edge that the start's face did not cover): the
-  // nearest face as well
+  // still within the margin (a concave mesh, a box's edge that the start's face did not cover, a
+  // body's blend that one push along the normal falls short of): the nearest face as well
   const float after = colliderDistance(part.shape, part.pose, xp, &n0);
-  if (after < margin - 1e-6f) {
-    xp -= (after - margin) * n0;
-    // a Body's push by the distance may fall short where its parts blend
-    if (part.shape.shape == ColliderShape::Body) pushOutOf(part.shape, part.pose, margin - 1e-6f, xp, &n0);
-  }
+  if (after < margin - 1e-6f) pushOutOf(part.shape, part.pose, margin, xp, &n0);
   if (!repeat) {
     const Vec3 slip = (xp - x) - colliderVelocity(owner, ownerPose, xp) * dt;  // motion relative to the surface
     xp += coulombFriction(slip, nrm, mu, -d) - slip;                // the normal push -d limits the friction
