@@ -26,10 +26,13 @@ struct Keyframe {
 
 // Body: a smooth union of sphere, capsule and box parts, each moved by its own keys (a skinned body:
 // the built-in mannequin, docs/mannequin.md)
-enum class ColliderShape { Plane, Box, Container, Sphere, Capsule, Mesh, Body };
+enum class ColliderShape { Plane, Box, Container, Sphere, Capsule, Mesh, Body, MeshSequence };
 
 // signed distance grid of a closed triangle mesh (src/world/mesh_sdf.hpp); immutable once built
 struct SdfGrid;
+
+// frames of one closed mesh topology, an animation (src/world/mesh_sequence.hpp); immutable once read
+struct MeshSequence;
 
 // springs, system pattern and wrinkle subdomains of a piece solved implicitly (src/garment/implicit.hpp)
 struct GarmentPiece;
@@ -50,6 +53,8 @@ struct Collider {
   // shared and read-only, and the radius k of the smooth minimum that joins them (m, > 0)
   std::shared_ptr<const std::vector<Collider>> parts;
   float blendRadius = 0.0f;
+  // mesh sequence: the frames (local frame), shared and read-only; its keys move it rigidly on top
+  std::shared_ptr<const MeshSequence> sequence;
   float friction = 0.3f;               // kinetic Coulomb coefficient, mixed with the particle's (core/friction.hpp)
   float staticFriction = 0.3f;         // static Coulomb coefficient, >= friction
   float restitution = 0.0f;            // 0..1: normal velocity kept, reversed, on contact

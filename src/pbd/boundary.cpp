@@ -9,40 +9,11 @@ namespace soak {
 
 namespace {
 
-// the world half extents of a sphere, capsule or box at rotation r; false for other shapes
-bool halfExtents(const Collider& c, const Eigen::Matrix3f& r, Vec3* half) {
-  switch (c.shape) {
-    case ColliderShape::Sphere: *half = Vec3::Constant(c.radius); return true;
-    case ColliderShape::Capsule: *half = r.col(1).cwiseAbs() * c.halfHeight + Vec3::Constant(c.radius); return true;
-    case ColliderShape::Box: *half = r.cwiseAbs() * c.halfExtents; return true;
-    default: return false;
-  }
-}
-
-// the world box of a sphere, capsule, box or body part at its pose (boundaryParts); planes and
-// meshes keep the infinite one. A body's surface is within its blend radius of its parts' union
-// (smoothMin.hpp: the fold of any number of parts is >= their min - k)
+// the world box of the part at its pose (world/colliders.hpp colliderBox); a plane keeps the
+// infinite one
 void setBounds(BoundaryPart& part) {
-  const Collider& c = part.shape;
-  Vec3 lo = Vec3::Constant(std::numeric_limits<float>::max()), hi = -lo;
-  if (c.shape == ColliderShape::Body) {
-    if (!c.parts || part.pose.parts.size() != c.parts->size()) return;
-    for (size_t k = 0; k < c.parts->size(); ++k) {
-      const ColliderPose& pose = part.pose.parts[k];
-      Vec3 half;
-      if (!halfExtents((*c.parts)[k], pose.rotation.normalized().toRotationMatrix(), &half)) return;
-      lo = lo.cwiseMin(pose.translation - half);
-      hi = hi.cwiseMax(pose.translation + half);
-    }
-    const Vec3 pad = Vec3::Constant(c.blendRadius);
-    lo -= pad;
-    hi += pad;
-  } else {
-    Vec3 half;
-    if (!halfExtents(c, part.pose.rotation.normalized().toRotationMatrix(), &half)) return;
-    lo = part.pose.translation - half;
-    hi = part.pose.translation + half;
-  }
+  Vec3 lo, hi;
+  if (!colliderBox(part.shape, part.pose, &lo, &hi)) return;
   // rounding of the rotation against colliderDistance's
   const Vec3 slack = 1e-5f * (hi - lo).cwiseAbs() + Vec3::Constant(1e-6f);
   part.lo = lo - slack;

@@ -17,7 +17,7 @@ namespace soak {
 struct BoundaryPart {
   Collider shape;
   ColliderPose pose;
-  // a world box that holds the part (infinite for planes and meshes): a point more than h outside it
+  // a world box that holds the part (infinite for a plane): a point more than h outside it
   // is farther than h from the part, whose distance then need not be computed
   Vec3 lo = Vec3::Constant(-std::numeric_limits<float>::infinity());
   Vec3 hi = Vec3::Constant(std::numeric_limits<float>::infinity());

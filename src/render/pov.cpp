@@ -104,7 +104,8 @@ void collider(Buf& b, const Collider& c, const ColliderPose& pose, const Surface
             "texture { Solid }");
       break;
     case ColliderShape::Body:
-      // its smooth skin at this frame's pose, meshed in the world frame (render.cpp)
+    case ColliderShape::MeshSequence:
+      // a body's smooth skin, a sequence's surface, at this frame's pose in the world frame (render.cpp)
       if (mesh == nullptr || mesh->triangles.empty()) return;
       b.append(std::string_view("object {\n"));
       mesh2(b, mesh->vertices, usableNormals(mesh->vertices, mesh->normals, mesh->triangles), mesh->triangles, {},
@@ -162,56 +163,11 @@ void Bounds::add(const Bounds& b) {
 }
 
 Bounds colliderBounds(const Collider& c, const ColliderPose& pose) {
-  Bounds local;
-  switch (c.shape) {
-    case ColliderShape::Plane:
-      return {};
-    case ColliderShape::Mesh:
-      if (c.sdf) {
-        local.add(c.sdf->origin);
-        local.add(c.sdf->origin + c.sdf->cellSize * Vec3(float(c.sdf->dims[0] - 1), float(c.sdf->dims[1] - 1),
-                                                         float(c.sdf->dims[2] - 1)));
-      }
-      break;
-    case ColliderShape::Box:
-      local.add(-c.halfExtents);
-      local.add(c.halfExtents);
-      break;
-    case ColliderShape::Container: {
-      Vec3 centres[kContainerWalls], halves[kContainerWalls];
-      containerWalls(c, centres, halves);
-      for (int k = 0; k < kContainerWalls; ++k) {
-        local.add(centres[k] - halves[k]);
-        local.add(centres[k] + halves[k]);
-      }
-      break;
-    }
-    case ColliderShape::Sphere:
-      local.add(Vec3::Zero(), c.radius);
-      break;
-    case ColliderShape::Capsule:
-      local.add(Vec3(0, -c.halfHeight, 0), c.radius);
-      local.add(Vec3(0, c.halfHeight, 0), c.radius);
-      break;
-    case ColliderShape::Body: {
-      // its parts' boxes, grown by the blend radius (the skin is within it of the parts' union)
-      Bounds world;
-      for (size_t k = 0; c.parts && k < c.parts->size() && k < pose.parts.size(); ++k)
-        world.add(colliderBounds((*c.parts)[k], pose.parts[k]));
-      if (world.empty()) return world;
-      const Vec3 lo = world.lo, hi = world.hi;
-      world.add(lo, c.blendRadius);
-      world.add(hi, c.blendRadius);
-      return world;
-    }
-  }
   Bounds world;
-  if (local.empty()) return world;  // a mesh without its distance grid: nothing to frame
-  for (int k = 0; k < 8; ++k) {
-    const Vec3 corner((k & 1) ? local.hi.x() : local.lo.x(), (k & 2) ? local.hi.y() : local.lo.y(),
-                      (k & 4) ? local.hi.z() : local.lo.z());
-    world.add(pose.rotation * corner + pose.translation);
-  }
+  Vec3 lo, hi;
+  if (!colliderBox(c, pose, &lo, &hi)) return world;  // a plane, or a mesh without its distance grid
+  world.add(lo);
+  world.add(hi);
   return world;
 }
 

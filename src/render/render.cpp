@@ -17,10 +17,21 @@
 #include "render/surface.hpp"
 #include "render/process.hpp"
 #include "world/colliders.hpp"
+#include "world/mesh_sequence.hpp"
 
 namespace soak {
 
 namespace {
+
+// a mesh sequence's surface at its pose, in the world frame (its normals from the faces, pov.cpp)
+SurfaceMesh sequenceSurface(const MeshSnapshot& mesh, const ColliderPose& pose) {
+  const TriangleMesh local = mesh.surface();
+  SurfaceMesh m;
+  m.vertices.reserve(local.vertices.size());
+  for (const Vec3& x : local.vertices) m.vertices.push_back(pose.rotation * x + pose.translation);
+  m.triangles = local.triangles;
+  return m;
+}
 
 namespace fs = std::filesystem;
 
@@ -94,6 +105,10 @@ std::string renderFrame(const FrameJob& job, int frame) {
   std::vector<SurfaceMesh> skins(model.colliders.size());
   for (size_t k = 0; k < model.colliders.size() && k < in.colliderMesh.size(); ++k) {
     const Collider& c = model.colliders[k];
+    if (c.shape == ColliderShape::MeshSequence && in.poses[k].mesh) {
+      skins[k] = sequenceSurface(*in.poses[k].mesh, in.poses[k]);
+      in.colliderMesh[k] = &skins[k];
+    }
     if (c.shape != ColliderShape::Body) continue;
     const Bounds box = colliderBounds(c, in.poses[k]);
     if (box.empty()) continue;

@@ -9,6 +9,7 @@
 #include "scene/limits.hpp"
 #include "world/garment_mesh.hpp"
 #include "world/mesh_sdf.hpp"
+#include "world/mesh_sequence.hpp"
 
 #include <fmt/format.h>
 
@@ -183,6 +184,29 @@ bool readMeshColliderShape(ObjectReader& r, Collider& c, const std::string& base
     const Collider m = loadMeshCollider(c.name, resolved, cell, padding);
     c.shape = ColliderShape::Mesh;
     c.sdf = m.sdf;
+    return true;
+  } catch (const Error& e) {
+    log.error(r.pathOf("path"), e.what());
+    return false;
+  }
+}
+
+bool readMeshSequenceShape(ObjectReader& r, Collider& c, const std::string& baseDir) {
+  ErrorLog& log = r.log();
+  const size_t errorsBefore = log.messages().size();
+  const std::string pattern = r.string("path", std::nullopt);
+  const float fps = r.number("fps", std::nullopt, Range::positive());
+  const float start = r.number("start", 0.0f, Range::any());
+  const float scale = r.number("scale", 1.0f, Range::positive());
+  const int first = r.has("firstFrame") ? r.integer("firstFrame", std::nullopt, Range::between(0, 999999999)) : -1;
+  const int last = r.has("lastFrame") ? r.integer("lastFrame", std::nullopt, Range::between(0, 999999999)) : -1;
+  if (first >= 0 && last >= 0 && last < first)
+    log.error(r.pathOf("lastFrame"), fmt::format("expected a frame >= firstFrame ({}), got {}", first, last));
+  if (log.messages().size() != errorsBefore) return false;
+  try {
+    const std::vector<std::string> files = meshSequenceFiles(resolvePath(pattern, baseDir), first, last, nullptr);
+    c.shape = ColliderShape::MeshSequence;
+    c.sequence = std::make_shared<const MeshSequence>(loadMeshSequence(files, fps, start, scale));
     return true;
   } catch (const Error& e) {
     log.error(r.pathOf("path"), e.what());

@@ -30,6 +30,10 @@ std::vector<Collider> readMannequin(ObjectReader& r, const std::string& name, Bo
 // the shape keys of a "mesh" collider (path, resolution, padding): sets c.sdf; false when invalid
 bool readMeshColliderShape(ObjectReader& r, Collider& c, const std::string& baseDir);
 
+// the shape keys of a "meshSequence" collider (path with '#' for the frame number, fps, start,
+// scale, firstFrame, lastFrame): reads the frames into c.sequence; false when invalid (logged)
+bool readMeshSequenceShape(ObjectReader& r, Collider& c, const std::string& baseDir);
+
 // the keys of a "rain" emitter (origin, halfExtents, rate, dropSpeed, dropRadius, direction, start, end)
 void readRain(ObjectReader& r, Emitter& e);
 

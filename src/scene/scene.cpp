@@ -265,12 +265,14 @@ void checkDripThreshold(ErrorLog& log, const Model& model, const std::vector<flo
   }
 }
 
-// in ColliderShape order, then the mannequin (many colliders)
-const std::vector<std::string> kColliderTypes = {"plane", "box", "container", "sphere", "capsule", "mesh", "mannequin"};
+// in ColliderShape order; a "mannequin" makes a Body
+const std::vector<std::string> kColliderTypes = {"plane", "box",  "container", "sphere",
+                                                 "capsule", "mesh", "mannequin", "meshSequence"};
 // the keys that only some collider types have
 const std::vector<std::string> kColliderShapeKeys = {"normal", "halfExtents", "wallThickness", "radius", "halfHeight",
                                                      "path",   "resolution",  "padding",       "height", "yaw",
-                                                     "proportions", "pose", "sampleInterval"};
+                                                     "proportions", "pose", "sampleInterval", "fps",
+                                                     "start", "scale", "firstFrame", "lastFrame"};
 
 std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, const std::string& path, int index,
                                                   const std::string& baseDir, Bodies& bodies) {
@@ -318,6 +320,10 @@ std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, 
       readMeshColliderShape(r, c, baseDir);
       mine = {"path", "resolution", "padding"};
       break;
+    case ColliderShape::MeshSequence:
+      readMeshSequenceShape(r, c, baseDir);
+      mine = {"path", "fps", "start", "scale", "firstFrame", "lastFrame"};
+      break;
     case ColliderShape::Body:  // only a "mannequin" makes one (read above)
       break;
   }
@@ -329,6 +335,7 @@ std::optional<std::vector<Collider>> readCollider(ErrorLog& log, const Json& v, 
     if (std::find(mine.begin(), mine.end(), k) == mine.end()) others.push_back(k);
   r.finish(others, "a " + kColliderTypes[size_t(type)] + " collider");
   if (c.shape == ColliderShape::Mesh && !c.sdf) return std::nullopt;
+  if (c.shape == ColliderShape::MeshSequence && !c.sequence) return std::nullopt;
   return std::vector<Collider>{c};
 }
 

@@ -5,6 +5,7 @@
 #include "core/friction.hpp"
 #include "world/container.hpp"
 #include "world/mesh_sdf.hpp"
+#include "world/mesh_sequence.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -33,6 +34,7 @@ float thicknessOf(const Collider& c) {
     case ColliderShape::Box: return 2.0f * c.halfExtents.minCoeff();
     case ColliderShape::Container: return c.wallThickness;
     case ColliderShape::Mesh: return c.sdf ? 2.0f * c.sdf->cellSize : std::numeric_limits<float>::infinity();
+    case ColliderShape::MeshSequence: return c.sequence ? c.sequence->thickness : std::numeric_limits<float>::infinity();
     case ColliderShape::Body: {
       float thinnest = std::numeric_limits<float>::infinity();
       if (c.parts)

@@ -4,6 +4,7 @@
 
 #include "world/container.hpp"
 #include "world/mesh_sdf.hpp"
+#include "world/mesh_sequence.hpp"
 #include "world/smooth_min.hpp"
 
 #include "core/parallel.hpp"
@@ -91,7 +92,9 @@ float localDistance(const Collider& c, const Vec3& p, Vec3* n) {
       if (c.sdf) return sampleSdf(*c.sdf, p, n);
       *n = Vec3(0, 1, 0);
       return 1.0e30f;
-    case ColliderShape::Body: break;  // in world space, from its parts' poses (blendDistance)
+    case ColliderShape::Body:          // in world space, from its parts' poses (blendDistance)
+    case ColliderShape::MeshSequence:  // from its pose's surface (sequenceDistance)
+      break;
   }
   *n = Vec3(0, 1, 0);
   return 1.0e30f;
@@ -106,6 +109,22 @@ ColliderPose composePose(const ColliderPose& root, const ColliderPose& local) {
   w.linearVelocity = root.linearVelocity + root.angularVelocity.cross(arm) + root.rotation * local.linearVelocity;
   w.angularVelocity = root.angularVelocity + root.rotation * local.angularVelocity;
   return w;
+}
+
+// a MeshSequence at world point p: the exact distance to its surface at the pose's time (local
+// frame), the surface's velocity on top of the rigid motion; a pose without its surface is far
+float sequenceDistance(const ColliderPose& pose, const Vec3& p, Vec3* normal, Vec3* velocity) {
+  if (!pose.mesh) {
+    if (normal) *normal = Vec3(0, 1, 0);
+    if (velocity) *velocity = pose.velocityAt(p);
+    return 1.0e30f;
+  }
+  const Vec3 local = pose.rotation.conjugate() * (p - pose.translation);
+  Vec3 n, v;
+  const float d = pose.mesh->distance(local, normal ? &n : nullptr, velocity ? &v : nullptr);
+  if (normal) *normal = pose.rotation * n;
+  if (velocity) *velocity = pose.velocityAt(p) + pose.rotation * v;
+  return d;
 }
 
 // a Body's smooth union at world point p: the parts' distances folded by smoothMin in part order,
@@ -147,6 +166,7 @@ float blendDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, 
 
 bool ColliderPose::moving() const {
   if (!linearVelocity.isZero() || !angularVelocity.isZero()) return true;
+  if (mesh && mesh->maxSpeed > 0.0f) return true;
   return std::any_of(parts.begin(), parts.end(), [](const ColliderPose& q) { return q.moving(); });
 }
 
@@ -178,6 +198,7 @@ ColliderPose colliderPose(const Collider& c, std::span<const Keyframe> keys, dou
     pose.parts.reserve(c.parts->size());
     for (const Collider& part : *c.parts) pose.parts.push_back(composePose(pose, keyframedPose(part.keys, t)));
   }
+  if (c.shape == ColliderShape::MeshSequence && c.sequence) pose.mesh = std::make_shared<const MeshSnapshot>(c.sequence, t);
   return pose;
 }
 
@@ -218,6 +239,7 @@ ColliderPose keyframedPose(std::span<const Keyframe> keys, double t) {
 
 float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal) {
   if (c.shape == ColliderShape::Body) return blendDistance(c, pose, p, normal, nullptr);
+  if (c.shape == ColliderShape::MeshSequence) return sequenceDistance(pose, p, normal, nullptr);
   const Vec3 local = pose.rotation.conjugate() * (p - pose.translation);
   Vec3 nLocal;
   const float d = localDistance(c, local, &nLocal);
@@ -268,9 +290,9 @@ bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& 
 }
 
 Vec3 colliderVelocity(const Collider& c, const ColliderPose& pose, const Vec3& p) {
-  if (c.shape != ColliderShape::Body) return pose.velocityAt(p);
-  Vec3 v;
-  blendDistance(c, pose, p, nullptr, &v);
+  Vec3 v = pose.velocityAt(p);
+  if (c.shape == ColliderShape::Body) blendDistance(c, pose, p, nullptr, &v);
+  if (c.shape == ColliderShape::MeshSequence) sequenceDistance(pose, p, nullptr, &v);
   return v;
 }
 
@@ -278,6 +300,7 @@ float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3
   float speed = pose.velocityAt(p).norm();
   if (c.shape == ColliderShape::Body)
     for (const ColliderPose& part : pose.parts) speed = std::max(speed, part.velocityAt(p).norm());
+  if (pose.mesh) speed += pose.mesh->maxSpeed;
   return speed;
 }
 
@@ -376,11 +399,22 @@ void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const f
     });
     return;
   }
+  // a mesh sequence is bounded by its box: the box's distance (negative inside) is the nearer
+  Collider box;
+  ColliderPose boxPose = pose;
+  if (c.shape == ColliderShape::MeshSequence) {
+    if (!pose.mesh) return;
+    box.shape = ColliderShape::Box;
+    box.halfExtents = 0.5f * (pose.mesh->hi - pose.mesh->lo);
+    boxPose.translation = pose.translation + pose.rotation * (0.5f * (pose.mesh->hi + pose.mesh->lo));
+  }
   parallelFor((n + kBoundChunk - 1) / kBoundChunk, [&](int64_t chunk) {
     const int64_t begin = chunk * kBoundChunk, count = std::min(n, begin + kBoundChunk) - begin;
     alignas(64) float d[kBoundChunk];
     if (c.shape == ColliderShape::Body)
       bodyChunkDistances(c, pose, X + 3 * begin, count, d);
+    else if (c.shape == ColliderShape::MeshSequence)
+      chunkDistances(box, boxPose, X + 3 * begin, count, d);
     else
       chunkDistances(c, pose, X + 3 * begin, count, d);
     float* const o = out + begin;
@@ -390,6 +424,74 @@ void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const f
       o[i] = v < o[i] ? v : o[i];
     }
   });
+}
+
+namespace {
+
+// the world box of the local box [lo, hi] at `pose`: centre moved, half extents through |R|
+void worldBox(const Vec3& lo, const Vec3& hi, const ColliderPose& pose, Vec3* worldLo, Vec3* worldHi) {
+  const Eigen::Matrix3f r = pose.rotation.normalized().toRotationMatrix();
+  const Vec3 centre = pose.translation + r * (0.5f * (lo + hi)), half = r.cwiseAbs() * (0.5f * (hi - lo));
+  *worldLo = centre - half;
+  *worldHi = centre + half;
+}
+
+}  // namespace
+
+bool colliderBox(const Collider& c, const ColliderPose& pose, Vec3* lo, Vec3* hi) {
+  switch (c.shape) {
+    case ColliderShape::Plane: return false;
+    case ColliderShape::Sphere:
+      *lo = pose.translation - Vec3::Constant(c.radius);
+      *hi = pose.translation + Vec3::Constant(c.radius);
+      return true;
+    case ColliderShape::Capsule: {
+      const Vec3 axis = pose.rotation.normalized() * Vec3(0, 1, 0);
+      const Vec3 half = axis.cwiseAbs() * c.halfHeight + Vec3::Constant(c.radius);
+      *lo = pose.translation - half;
+      *hi = pose.translation + half;
+      return true;
+    }
+    case ColliderShape::Box: worldBox(-c.halfExtents, c.halfExtents, pose, lo, hi); return true;
+    case ColliderShape::Container: {
+      Vec3 centres[kContainerWalls], halves[kContainerWalls];
+      containerWalls(c, centres, halves);
+      Vec3 l = centres[0] - halves[0], h = centres[0] + halves[0];
+      for (int k = 1; k < kContainerWalls; ++k) {
+        l = l.cwiseMin(centres[k] - halves[k]);
+        h = h.cwiseMax(centres[k] + halves[k]);
+      }
+      worldBox(l, h, pose, lo, hi);
+      return true;
+    }
+    case ColliderShape::Mesh: {
+      if (!c.sdf) return false;
+      const Vec3 far = c.sdf->cellSize * Vec3(float(c.sdf->dims[0] - 1), float(c.sdf->dims[1] - 1), float(c.sdf->dims[2] - 1));
+      worldBox(c.sdf->origin, c.sdf->origin + far, pose, lo, hi);
+      return true;
+    }
+    case ColliderShape::MeshSequence:
+      if (!pose.mesh) return false;
+      worldBox(pose.mesh->lo, pose.mesh->hi, pose, lo, hi);
+      return true;
+    case ColliderShape::Body: {
+      // its parts' boxes grown by the blend radius: the skin is within it of the parts' union
+      // (smooth_min.hpp: the fold of any number of parts is >= their min - k)
+      if (!c.parts || c.parts->empty() || pose.parts.size() != c.parts->size()) return false;
+      *lo = Vec3::Constant(std::numeric_limits<float>::max());
+      *hi = -*lo;
+      for (size_t k = 0; k < c.parts->size(); ++k) {
+        Vec3 l, h;
+        if (!colliderBox((*c.parts)[k], pose.parts[k], &l, &h)) return false;
+        *lo = lo->cwiseMin(l);
+        *hi = hi->cwiseMax(h);
+      }
+      *lo -= Vec3::Constant(c.blendRadius);
+      *hi += Vec3::Constant(c.blendRadius);
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace soak

@@ -7,11 +7,14 @@
 
 #include "core/parallel.hpp"
 
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace soak {
+
+class MeshSnapshot;  // world/mesh_sequence.hpp
 
 // world pose of a collider at time t and its rigid velocity field
 struct ColliderPose {
@@ -22,11 +25,14 @@ struct ColliderPose {
   Vec3 velocityAt(const Vec3& p) const { return linearVelocity + angularVelocity.cross(p - translation); }
   // a Body collider: the world pose of each of its parts (the body's pose composed with the part's)
   std::vector<ColliderPose> parts;
+  // a MeshSequence collider: its surface at this time (local frame), shared by copies of the pose
+  std::shared_ptr<const MeshSnapshot> mesh;
   bool moving() const;  // a velocity, its own or a part's, is not zero
 };
 
 // pose at time t: translation interpolated linearly between keyframes, rotation by slerp, the ends
-// held; velocities from the keyframe segment containing t
+// held; velocities from the keyframe segment containing t. A MeshSequence's pose holds its surface
+// at t (a tree over its triangles is built: pose it once per substep, not per point)
 ColliderPose colliderPose(const Collider& c, double t);
 // the same with the collider's keys replaced by `keys` (a Body's parts keep theirs, relative to them)
 ColliderPose colliderPose(const Collider& c, std::span<const Keyframe> keys, double t);
@@ -49,9 +55,10 @@ bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& 
 
 // velocity (m/s) of the collider's surface material at world point p: the rigid field of the pose,
 // or for a Body its parts' fields blended with the weights of its normal (a point of the skin between
-// two bones moves as a mix of both)
+// two bones moves as a mix of both); a MeshSequence adds its nearest surface point's own motion
 Vec3 colliderVelocity(const Collider& c, const ColliderPose& pose, const Vec3& p);
-// an upper bound of |colliderVelocity(c, pose, p)| that costs no distance (a Body: its fastest part)
+// an upper bound of |colliderVelocity(c, pose, p)| that costs no distance (a Body: its fastest part;
+// a MeshSequence: its fastest vertex on top of the rigid motion)
 float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3& p);
 
 // a Body collider joining `parts` (sphere, capsule or box colliders, their keys in the body's frame)
@@ -64,10 +71,15 @@ Collider makeBodyCollider(const std::string& name, std::vector<Collider> parts, 
 // a lower bound of colliderDistance(c, pose, x_i) for the n points x_i = X[3i .. 3i+2], min-ed into
 // out[i] (out[i] = min(out[i], bound)): exact up to kDistanceBoundSlack for planes, spheres, capsules,
 // boxes, containers and bodies, in a vectorised loop without normals; a mesh collider gets its exact
-// distance.
+// distance, a mesh sequence the distance to its box (which holds it, so is nearer).
 // For skipping the points that cannot be within some distance of the collider
 constexpr float kDistanceBoundSlack = 1e-4f;  // m, covers the rounding of the matrix against the quaternion
 void colliderDistanceBounds(const Collider& c, const ColliderPose& pose, const float* X, int64_t n, float* out);
+
+// the world box that holds the collider's solid at `pose` (its exact box for the convex shapes, its
+// grid's for a mesh, its parts' grown by the blend radius for a body, its vertices' for a mesh
+// sequence); false for a plane and a shape without its data (a mesh without a grid)
+bool colliderBox(const Collider& c, const ColliderPose& pose, Vec3* lo, Vec3* hi);
 
 // contact margin of a particle against colliders: water keeps half its spacing, cloth half its
 // thickness

@@ -3,6 +3,8 @@
 // pseudo-normals (Baerentzen & Aanaes 2005), which are exact on a closed oriented mesh.
 #include "world/mesh_sdf.hpp"
 
+#include "world/mesh_distance.hpp"
+
 #include <soak/error.hpp>
 
 #include "core/parallel.hpp"
@@ -17,52 +19,12 @@ namespace soak {
 
 namespace {
 
-// closest-point features of a triangle: the face, edge k (vertices k, k+1) or vertex k
-enum Feature { kFace = 0, kEdge0 = 1, kVertex0 = 4 };
-
-// closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection 5.1.5), with the
-// feature it lies on
-Vec3d closestOnTriangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c, int* feature) {
-  const Vec3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return *feature = kVertex0 + 0, a;
-  const Vec3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return *feature = kVertex0 + 1, b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    *feature = kEdge0 + 0;
-    return a + (d1 / (d1 - d3)) * ab;
-  }
-  const Vec3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return *feature = kVertex0 + 2, c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    *feature = kEdge0 + 2;  // edge (c, a)
-    return a + (d2 / (d2 - d6)) * ac;
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    *feature = kEdge0 + 1;  // edge (b, c)
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  }
-  const double denom = 1.0 / (va + vb + vc);
-  *feature = kFace;
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
 // a checked, outward-oriented mesh in double with the pseudo-normals of every feature
 struct PreparedMesh {
   std::vector<Vec3d> x;
   std::vector<std::array<int, 3>> tri;
-  std::vector<Vec3d> faceNormal;               // unit
-  std::vector<std::array<Vec3d, 3>> edgeNormal;  // per triangle edge k (k, k+1): sum of both faces
-  std::vector<Vec3d> vertexNormal;             // angle-weighted sum of the faces around
+  FeatureNormals normals;
 };
-
-// "(a, b)" (fmt: the inlined string concatenation draws a false -Wrestrict warning)
-std::string edgeText(int a, int b) { return fmt::format("({}, {})", a, b); }
 
 // the mesh in double; throws on a non-finite position or an index out of range
 void copyChecked(const TriangleMesh& mesh, const std::string& source, PreparedMesh& m) {
@@ -83,119 +45,19 @@ void copyChecked(const TriangleMesh& mesh, const std::string& source, PreparedMe
                           ")");
 }
 
-// a triangle's edge k as (lo, hi) vertices and its direction along them
-struct Half {
-  int lo, hi, dir, tri, k;
-};
-
-// twin[t][k]: the triangle across edge k of triangle t. Throws unless the mesh is closed and
-// consistently oriented: every directed edge (a, b) has exactly one twin (b, a)
-std::vector<std::array<int, 3>> twinTriangles(const std::vector<std::array<int, 3>>& tri, const std::string& source) {
-  std::vector<Half> halves;
-  halves.reserve(tri.size() * 3);
-  for (int t = 0; t < static_cast<int>(tri.size()); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const int a = tri[t][k], b = tri[t][(k + 1) % 3];
-      halves.push_back({std::min(a, b), std::max(a, b), a < b ? 0 : 1, t, k});
-    }
-  std::sort(halves.begin(), halves.end(), [](const Half& p, const Half& q) {
-    if (p.lo != q.lo) return p.lo < q.lo;
-    if (p.hi != q.hi) return p.hi < q.hi;
-    return p.tri < q.tri;
-  });
-  std::vector<std::array<int, 3>> twin(tri.size(), {-1, -1, -1});
-  for (size_t s = 0; s < halves.size();) {
-    size_t e = s;
-    while (e < halves.size() && halves[e].lo == halves[s].lo && halves[e].hi == halves[s].hi) ++e;
-    const std::string edge = edgeText(halves[s].lo, halves[s].hi);
-    if (e - s != 2)
-      throw errorAt(source, "mesh collider, edge " + edge,
-                    "the edge belongs to " + std::to_string(e - s) +
-                        " triangle(s); a mesh collider must be a closed surface (every edge in exactly two "
-                        "triangles)");
-    if (halves[s].dir == halves[s + 1].dir)
-      throw errorAt(source, "mesh collider, edge " + edge,
-                    "triangles " + std::to_string(halves[s].tri) + " and " + std::to_string(halves[s + 1].tri) +
-                        " run the same way along the edge; expected a consistently oriented surface");
-    twin[halves[s].tri][halves[s].k] = halves[s + 1].tri;
-    twin[halves[s + 1].tri][halves[s + 1].k] = halves[s].tri;
-    s = e;
-  }
-  return twin;
-}
-
-// flips every triangle when the signed volume (divergence theorem) is negative: the normals pointed
-// inwards
-void orientOutward(PreparedMesh& m) {
-  double volume = 0.0;
-  for (const auto& t : m.tri) volume += m.x[t[0]].dot(m.x[t[1]].cross(m.x[t[2]])) / 6.0;
-  if (volume < 0.0)
-    for (auto& t : m.tri) std::swap(t[1], t[2]);
-}
-
-// unit face normals; throws on a degenerate triangle
-void faceNormals(PreparedMesh& m, const std::string& source) {
-  m.faceNormal.resize(m.tri.size());
-  for (size_t t = 0; t < m.tri.size(); ++t) {
-    const Vec3d n = (m.x[m.tri[t][1]] - m.x[m.tri[t][0]]).cross(m.x[m.tri[t][2]] - m.x[m.tri[t][0]]);
-    if (!(n.norm() > 0.0))
-      throw errorAt(source, "mesh collider, triangle " + std::to_string(t), "degenerate triangle (zero area)");
-    m.faceNormal[t] = n.normalized();
-  }
-}
-
-// the pseudo-normals of the edges (sum of both faces) and the vertices (angle-weighted sum of the
-// faces around). Twins are found by their vertices, so orientOutward's swap does not disturb them
-void featureNormals(PreparedMesh& m, const std::vector<std::array<int, 3>>& twin) {
-  m.edgeNormal.resize(m.tri.size());
-  m.vertexNormal.assign(m.x.size(), Vec3d::Zero());
-  for (size_t t = 0; t < m.tri.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = m.tri[t][k], b = m.tri[t][(k + 1) % 3];
-      // the twin of edge (a, b) is the triangle that holds both a and b besides t
-      int other = -1;
-      for (int slot = 0; slot < 3; ++slot) {
-        const int o = twin[t][slot];
-        if (o < 0) continue;
-        const auto& ot = m.tri[o];
-        const bool hasA = ot[0] == a || ot[1] == a || ot[2] == a, hasB = ot[0] == b || ot[1] == b || ot[2] == b;
-        if (hasA && hasB) other = o;
-      }
-      m.edgeNormal[t][k] = m.faceNormal[t] + (other >= 0 ? m.faceNormal[other] : m.faceNormal[t]);
-      // vertex pseudo-normal: each face weighted by its angle at the vertex
-      const Vec3d e1 = (m.x[b] - m.x[a]).normalized(), e2 = (m.x[m.tri[t][(k + 2) % 3]] - m.x[a]).normalized();
-      m.vertexNormal[a] += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * m.faceNormal[t];
-    }
-  }
-}
-
+// checked, closed, flipped outward when its normals pointed inwards, with its pseudo-normals;
+// throws on a degenerate triangle
 PreparedMesh prepare(const TriangleMesh& mesh, const std::string& source) {
   PreparedMesh m;
   copyChecked(mesh, source, m);
   const std::vector<std::array<int, 3>> twin = twinTriangles(m.tri, source);
-  orientOutward(m);
-  faceNormals(m, source);
-  featureNormals(m, twin);
+  if (signedVolume(m.x, m.tri) < 0.0)
+    for (auto& t : m.tri) std::swap(t[1], t[2]);
+  featureNormals(m.x, m.tri, twin, m.normals);
+  for (size_t t = 0; t < m.tri.size(); ++t)
+    if (!(m.normals.face[t].squaredNorm() > 0.0))
+      throw errorAt(source, "mesh collider, triangle " + std::to_string(t), "degenerate triangle (zero area)");
   return m;
-}
-
-// unsigned squared distance from p to triangle t and the sign from the nearest feature's normal
-struct Nearest {
-  double dist2 = std::numeric_limits<double>::infinity();
-  double sign = 1.0;
-};
-
-void testTriangle(const PreparedMesh& m, int t, const Vec3d& p, Nearest& best) {
-  const auto& tr = m.tri[t];
-  int feature = kFace;
-  const Vec3d q = closestOnTriangle(p, m.x[tr[0]], m.x[tr[1]], m.x[tr[2]], &feature);
-  const double d2 = (p - q).squaredNorm();
-  if (!(d2 < best.dist2)) return;
-  const Vec3d* n = &m.faceNormal[t];
-  if (feature >= kVertex0) n = &m.vertexNormal[tr[feature - kVertex0]];
-  else if (feature >= kEdge0) n = &m.edgeNormal[t][feature - kEdge0];
-  best.dist2 = d2;
-  best.sign = (p - q).dot(*n) < 0.0 ? -1.0 : 1.0;
 }
 
 // triangles binned by bounding box into buckets of kBucket^3 grid cells, as lists per bucket (CSR)
@@ -279,7 +141,7 @@ TriangleBuckets bucketTriangles(const PreparedMesh& m, const SdfGrid& g, const V
 double nearestInRings(const PreparedMesh& m, const TriangleBuckets& tb, const Vec3d& p, int bi, int bj, int bk) {
   const std::array<int, 3>& nb = tb.n;
   const int maxRing = std::max({nb[0], nb[1], nb[2]});
-  Nearest best;
+  NearestOnMesh best;
   // ring r holds the buckets at Chebyshev distance r; anything beyond it is >= r bucket sizes away
   for (int r = 0; r <= maxRing; ++r) {
     for (int c = std::max(bk - r, 0); c <= std::min(bk + r, nb[2] - 1); ++c)
@@ -287,7 +149,7 @@ double nearestInRings(const PreparedMesh& m, const TriangleBuckets& tb, const Ve
         for (int a = std::max(bi - r, 0); a <= std::min(bi + r, nb[0] - 1); ++a) {
           if (std::max({std::abs(a - bi), std::abs(b - bj), std::abs(c - bk)}) != r) continue;
           const int64_t bucket = tb.index(a, b, c);
-          for (int s = tb.start[bucket]; s < tb.start[bucket + 1]; ++s) testTriangle(m, tb.tris[s], p, best);
+          for (int s = tb.start[bucket]; s < tb.start[bucket + 1]; ++s) nearerTriangle(m.x, m.tri, m.normals, tb.tris[s], p, best);
         }
     const double reach = r * tb.size;
     if (best.dist2 <= reach * reach) break;
@@ -299,8 +161,8 @@ double nearestInRings(const PreparedMesh& m, const TriangleBuckets& tb, const Ve
 
 double exactMeshDistance(const TriangleMesh& mesh, const Vec3d& p) {
   const PreparedMesh m = prepare(mesh, "mesh");
-  Nearest best;
-  for (int t = 0; t < static_cast<int>(m.tri.size()); ++t) testTriangle(m, t, p, best);
+  NearestOnMesh best;
+  for (int t = 0; t < static_cast<int>(m.tri.size()); ++t) nearerTriangle(m.x, m.tri, m.normals, t, p, best);
   return best.sign * std::sqrt(best.dist2);
 }
 

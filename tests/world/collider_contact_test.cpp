@@ -5,6 +5,7 @@
 #include "core/friction.hpp"
 
 #include "world/mesh_sdf.hpp"
+#include "world/mesh_sequence.hpp"
 
 #include "support/colliders.hpp"
 
@@ -217,6 +218,40 @@ TEST(ColliderFriction, MovingColliderDragsParticleAtMostAtMuG) {
   }
 }
 
+// a mesh sequence's surface carries what rests on it by its vertices' motion, not a rigid pose: a
+// slab whose frames slide it along x at 0.5 m/s drags a particle on it up to its speed (mu = 1, as
+// MovingColliderDragsParticleAtMostAtMuG), and a slab whose frames lift it lifts the particle
+TEST(ColliderFriction, AMeshSequenceCarriesWhatRestsOnIt) {
+  TriangleMesh slab = cubeMesh(1.0f);
+  for (Vec3& x : slab.vertices) x = Vec3(x.x(), 0.05f * (x.y() - 1.0f), x.z());  // top face at y = 0
+  std::vector<TriangleMesh> frames;
+  for (int f = 0; f <= 10; ++f) {
+    frames.push_back(slab);
+    for (Vec3& x : frames.back().vertices) x += Vec3(0.05f * f, 0.0f, 0.0f);  // 0.5 m/s at 10 fps
+  }
+  Model m = slopeModel(0.0f, {1.0f, 1.0f});
+  m.colliders[0] = makeCollider(ColliderShape::MeshSequence);
+  m.colliders[0].friction = m.colliders[0].staticFriction = 1.0f;
+  m.colliders[0].sequence = std::make_shared<const MeshSequence>(makeMeshSequence(frames, {}, 10.0, 0.0));
+  Particles p;
+  p.add(1, 0, 0.006f, 0.0f, Vec3(0, 0.005f, 0), Vec3::Zero());
+  const float h = 0.002f;
+  simulate(m, p, h, 250);  // 0.5 s
+  EXPECT_NEAR(p.x[0].y(), 0.005f, 1e-5f);
+  const float lag = 0.5f * 0.5f / (2.0f * 9.81f);  // distance lost while catching up
+  EXPECT_NEAR(p.x[0].x(), 0.25f - lag, 0.5f * h * 0.5f + 1e-5f);
+  EXPECT_NEAR(p.v[0].x(), 0.5f, 1e-3f);
+  // lifted at 0.4 m/s for 0.5 s: the particle rides on the top face, at its margin
+  for (size_t f = 0; f < frames.size(); ++f)
+    for (size_t v = 0; v < slab.vertices.size(); ++v) frames[f].vertices[v] = slab.vertices[v] + Vec3(0, 0.04f * f, 0);
+  m.colliders[0].sequence = std::make_shared<const MeshSequence>(makeMeshSequence(frames, {}, 10.0, 0.0));
+  Particles q;
+  q.add(1, 0, 0.006f, 0.0f, Vec3(0, 0.005f, 0), Vec3::Zero());
+  simulate(m, q, h, 250);
+  EXPECT_NEAR(q.x[0].y(), 0.2f + 0.005f, 1e-4f);
+  EXPECT_NEAR(q.v[0].y(), 0.4f, 1e-2f);
+}
+
 // a particle in a container's floor-wall edge, within the margin of both, is pushed out of both in one
 // projection, so at rest under gravity it stays still (against the container's single nearest face it
 // was pushed out of the floor and the wall in turn and jittered at 0.5 m/s)
@@ -238,7 +273,7 @@ TEST(ColliderContact, ContainerEdgePushesOutOfFloorAndWallAtOnce) {
 }
 
 // no speed up to solver.maxSpeed carries a particle through a collider in one substep: fired at a
-// container wall, a box, a sphere, a capsule and a mesh cube at 3 to 50 m/s (0.045 to 0.75 m a
+// container wall, a box, a sphere, a capsule, a mesh cube and a mesh sequence's cube at 3 to 50 m/s (0.045 to 0.75 m a
 // substep), straight and at 30 degrees to the flat faces, it ends on the near side at the margin, and
 // is counted
 TEST(ColliderContact, NoSpeedCarriesAParticleThroughAnyCollider) {
@@ -261,7 +296,10 @@ TEST(ColliderContact, NoSpeedCarriesAParticleThroughAnyCollider) {
   Collider mesh = makeCollider(ColliderShape::Mesh);
   mesh.sdf = std::make_shared<SdfGrid>(buildSdfGrid(cubeMesh(0.1f), 0.01f, 0.05f, "cube"));
   mesh.keys[0].translation = Vec3(0.6f, 0.4f, 0);  // faces at x = 0.5 and 0.7
-  for (Collider c : {wall, box, sphere, capsule, mesh}) {
+  Collider sequence = makeCollider(ColliderShape::MeshSequence);  // the same cube, exact, as an animation's frame
+  sequence.sequence = std::make_shared<const MeshSequence>(makeMeshSequence({cubeMesh(0.1f)}, {}, 24.0, 0.0));
+  sequence.keys[0].translation = Vec3(0.6f, 0.4f, 0);
+  for (Collider c : {wall, box, sphere, capsule, mesh, sequence}) {
     c.friction = c.staticFriction = 0.0f;
     const bool flat = c.shape != ColliderShape::Sphere && c.shape != ColliderShape::Capsule;
     for (float speed : {3.0f, 10.0f, 50.0f}) {

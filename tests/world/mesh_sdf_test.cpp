@@ -19,46 +19,8 @@ namespace soak {
 namespace {
 
 using testing::cubeMesh;
-
-// icosphere of radius r: an icosahedron subdivided `levels` times, vertices on the sphere
-TriangleMesh icosphere(float r, int levels) {
-  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-  TriangleMesh m;
-  m.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<int, int>, int> mid;
-    auto midpoint = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      m.vertices.push_back(0.5f * (m.vertices[a] + m.vertices[b]));
-      return mid[key] = static_cast<int>(m.vertices.size()) - 1;
-    };
-    std::vector<std::array<int, 3>> next;
-    for (const auto& tr : m.triangles) {
-      const int a = midpoint(tr[0], tr[1]), b = midpoint(tr[1], tr[2]), c = midpoint(tr[2], tr[0]);
-      next.push_back({tr[0], a, c});
-      next.push_back({tr[1], b, a});
-      next.push_back({tr[2], c, b});
-      next.push_back({a, b, c});
-    }
-    m.triangles = next;
-  }
-  for (Vec3& v : m.vertices) v = r * v.normalized();
-  return m;
-}
-
-std::string writeObj(const TriangleMesh& m, const std::string& name) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
-  std::ofstream f(path);
-  for (const Vec3& v : m.vertices) f << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
-  for (const auto& t : m.triangles) f << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
-  return path;
-}
+using testing::icosphere;
+using testing::writeObj;
 
 float boxDistance(const Vec3& p, float h) {
   const Vec3 q = p.cwiseAbs() - Vec3::Constant(h);

@@ -1,0 +1,279 @@
+// animated mesh colliders (mesh_sequence.hpp): loading an OBJ sequence, checking its topology, and
+// the exact signed distance to its interpolated surface through a CGAL AABB tree
+#include "world/mesh_sequence.hpp"
+
+#include <soak/error.hpp>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace soak {
+
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using KernelTriangles = std::vector<Kernel::Triangle_3>;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, KernelTriangles::const_iterator>;
+using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+Kernel::Point_3 point(const Vec3d& x) { return {x.x(), x.y(), x.z()}; }
+
+// frame f's topology against frame 0's; throws naming its file
+void checkSameTopology(const TriangleMesh& first, const TriangleMesh& frame, const std::string& name, size_t f) {
+  const std::string where = fmt::format("mesh sequence, frame {}", f);
+  if (frame.vertices.size() != first.vertices.size())
+    throw errorAt(name, where,
+                  fmt::format("expected {} vertices as in the first frame, got {} (every frame must have the same "
+                              "topology: export the animation without changing the mesh)",
+                              first.vertices.size(), frame.vertices.size()));
+  if (frame.triangles.size() != first.triangles.size())
+    throw errorAt(name, where,
+                  fmt::format("expected {} triangles as in the first frame, got {}", first.triangles.size(),
+                              frame.triangles.size()));
+  for (size_t t = 0; t < frame.triangles.size(); ++t)
+    if (frame.triangles[t] != first.triangles[t])
+      throw errorAt(name, fmt::format("{}, triangle {}", where, t),
+                    fmt::format("expected vertices ({}, {}, {}) as in the first frame, got ({}, {}, {})",
+                                first.triangles[t][0] + 1, first.triangles[t][1] + 1, first.triangles[t][2] + 1,
+                                frame.triangles[t][0] + 1, frame.triangles[t][1] + 1, frame.triangles[t][2] + 1));
+}
+
+float medianEdgeLength(const MeshSequence& s) {
+  std::vector<float> lengths;
+  lengths.reserve(3 * s.triangles.size());
+  for (const auto& t : s.triangles)
+    for (int k = 0; k < 3; ++k) lengths.push_back((s.positions[t[(k + 1) % 3]] - s.positions[t[k]]).norm());
+  auto mid = lengths.begin() + lengths.size() / 2;
+  std::nth_element(lengths.begin(), mid, lengths.end());
+  return *mid;
+}
+
+// the barycentric weights of q (on triangle a, b, c) for interpolating a vertex quantity
+Vec3d barycentric(const Vec3d& q, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d e0 = b - a, e1 = c - a, r = q - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1), d20 = r.dot(e0), d21 = r.dot(e1);
+  const double den = d00 * d11 - d01 * d01;
+  if (!(den > 0.0)) return Vec3d(1.0, 0.0, 0.0);
+  const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+  return Vec3d(1.0 - v - w, v, w);
+}
+
+}  // namespace
+
+MeshSequence makeMeshSequence(const std::vector<TriangleMesh>& frames, const std::vector<std::string>& names,
+                              double fps, double start) {
+  const auto nameOf = [&](size_t f) { return f < names.size() ? names[f] : fmt::format("frame {}", f); };
+  if (frames.empty()) throw errorAt(nameOf(0), "mesh sequence", "expected at least one frame");
+  if (!(fps > 0.0) || !std::isfinite(fps))
+    throw errorAt(nameOf(0), "mesh sequence", fmt::format("expected fps > 0, got {}", fps));
+  MeshSequence s;
+  s.fps = fps;
+  s.start = start;
+  s.frameCount = static_cast<int>(frames.size());
+  s.vertexCount = static_cast<int>(frames[0].vertices.size());
+  s.triangles = frames[0].triangles;
+  if (s.triangles.empty()) throw errorAt(nameOf(0), "mesh sequence", "the first frame has no triangles");
+  for (size_t t = 0; t < s.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (s.triangles[t][k] < 0 || s.triangles[t][k] >= s.vertexCount)
+        throw errorAt(nameOf(0), fmt::format("mesh sequence, triangle {}", t),
+                      fmt::format("vertex index {} is out of range [1, {}]", s.triangles[t][k] + 1, s.vertexCount));
+  s.positions.reserve(size_t(s.vertexCount) * frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (f > 0) checkSameTopology(frames[0], frames[f], nameOf(f), f);
+    for (size_t v = 0; v < frames[f].vertices.size(); ++v) {
+      if (!frames[f].vertices[v].allFinite())
+        throw errorAt(nameOf(f), fmt::format("mesh sequence, frame {}, vertex {}", f, v + 1), "position is not finite");
+      s.positions.push_back(frames[f].vertices[v]);
+    }
+  }
+  s.twin = twinTriangles(s.triangles, nameOf(0));
+  // outward by frame 0; a closed mesh keeps its orientation through a motion that does not turn it inside out
+  std::vector<Vec3d> x0(size_t(s.vertexCount));
+  for (size_t v = 0; v < x0.size(); ++v) x0[v] = s.positions[v].cast<double>();
+  if (signedVolume(x0, s.triangles) < 0.0)
+    for (auto& t : s.triangles) std::swap(t[1], t[2]);
+  FeatureNormals n0;
+  featureNormals(x0, s.triangles, s.twin, n0);
+  for (size_t t = 0; t < s.triangles.size(); ++t)
+    if (!(n0.face[t].squaredNorm() > 0.0))
+      throw errorAt(nameOf(0), fmt::format("mesh sequence, frame 0, triangle {}", t), "degenerate triangle (zero area)");
+  s.thickness = medianEdgeLength(s);
+  return s;
+}
+
+namespace {
+
+// the run of '#' in the pattern's file name: [begin, end) in the whole pattern
+std::pair<size_t, size_t> hashRun(const std::string& pattern) {
+  const size_t slash = pattern.find_last_of('/');
+  const size_t nameStart = slash == std::string::npos ? 0 : slash + 1;
+  const size_t b = pattern.find('#', nameStart);
+  if (b == std::string::npos)
+    throw errorAt(pattern, "mesh sequence path",
+                  "expected one run of '#' in the file name standing for the frame number (body_####.obj)");
+  size_t e = b;
+  while (e < pattern.size() && pattern[e] == '#') ++e;
+  if (pattern.find('#', e) != std::string::npos)
+    throw errorAt(pattern, "mesh sequence path", "expected one run of '#' in the file name, got several");
+  return {b, e};
+}
+
+std::string framePath(const std::string& pattern, std::pair<size_t, size_t> run, int frame) {
+  return pattern.substr(0, run.first) + fmt::format("{:0{}d}", frame, run.second - run.first) +
+         pattern.substr(run.second);
+}
+
+// the lowest frame number whose file exists, -1 if none
+int lowestFrame(const std::string& pattern, std::pair<size_t, size_t> run) {
+  const std::filesystem::path dir = std::filesystem::path(pattern.substr(0, run.first)).parent_path();
+  const size_t nameStart = dir.empty() ? 0 : pattern.find_last_of('/') + 1;
+  const std::string prefix = pattern.substr(nameStart, run.first - nameStart), suffix = pattern.substr(run.second);
+  std::error_code ec;
+  int lowest = -1;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.empty() ? "." : dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() <= prefix.size() + suffix.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      continue;
+    const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+    if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; }))
+      continue;
+    const int frame = std::stoi(digits);
+    // the name the pattern gives that frame (its padding), so "body_1.obj" is not taken for "body_0001.obj"
+    if (framePath(pattern, run, frame).substr(nameStart) != name) continue;
+    if (lowest < 0 || frame < lowest) lowest = frame;
+  }
+  return lowest;
+}
+
+}  // namespace
+
+std::vector<std::string> meshSequenceFiles(const std::string& pattern, int first, int last, int* firstFound) {
+  const auto run = hashRun(pattern);
+  if (first < 0) first = lowestFrame(pattern, run);
+  if (first < 0)
+    throw errorAt(pattern, "mesh sequence path",
+                  fmt::format("expected files named by the pattern, found none (the first would be \"{}\")",
+                              framePath(pattern, run, 1)));
+  if (last >= 0 && last < first)
+    throw errorAt(pattern, "mesh sequence", fmt::format("expected lastFrame >= firstFrame ({}), got {}", first, last));
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (int f = first; last < 0 || f <= last; ++f) {
+    const std::string path = framePath(pattern, run, f);
+    if (!std::filesystem::is_regular_file(path, ec)) {
+      if (last >= 0 || f == first)
+        throw errorAt(path, "mesh sequence", fmt::format("expected frame {} of the sequence, the file does not exist", f));
+      break;
+    }
+    files.push_back(path);
+  }
+  if (firstFound) *firstFound = first;
+  return files;
+}
+
+MeshSequence loadMeshSequence(const std::vector<std::string>& files, double fps, double start, float scale) {
+  if (files.empty()) throw errorAt("", "mesh sequence", "expected at least one frame file");
+  if (!(scale > 0.0f) || !std::isfinite(scale))
+    throw errorAt(files[0], "mesh sequence", fmt::format("expected a scale > 0, got {}", scale));
+  std::vector<TriangleMesh> frames;
+  frames.reserve(files.size());
+  for (size_t f = 0; f < files.size(); ++f) {
+    frames.push_back(loadObjMesh(files[f]));
+    if (f == 0 && int64_t(frames[0].vertices.size()) * int64_t(files.size()) > kMaxSequencePositions)
+      throw errorAt(files[0], "mesh sequence",
+                    fmt::format("{} frames of {} vertices are more than {} positions; use fewer frames or a coarser "
+                                "mesh",
+                                files.size(), frames[0].vertices.size(), kMaxSequencePositions));
+    for (Vec3& x : frames.back().vertices) x *= scale;
+    // the positions are copied into the sequence: check each frame as it comes, keep memory to two copies
+    if (f > 0) checkSameTopology(frames[0], frames[f], files[f], f);
+  }
+  return makeMeshSequence(frames, files, fps, start);
+}
+
+struct MeshSnapshot::Tree {
+  KernelTriangles triangles;  // the non-degenerate triangles at this time
+  std::vector<int> ids;       // their index in the sequence
+  AabbTree tree;
+};
+
+MeshSnapshot::MeshSnapshot(std::shared_ptr<const MeshSequence> sequence, double t)
+    : sequence_(std::move(sequence)), tree_(std::make_unique<Tree>()) {
+  const MeshSequence& s = *sequence_;
+  const int nv = s.vertexCount;
+  const double u = (t - s.start) * s.fps;
+  const int last = s.frameCount - 1;
+  // frame f's segment holds u in [f, f + 1), so frame 0 already moves with its segment (as keyframes do)
+  const bool playing = u >= 0.0 && u < last;
+  const int f = u <= 0.0 ? 0 : (u >= last ? last : static_cast<int>(std::floor(u)));
+  const double w = playing ? u - f : 0.0;
+  const int g = std::min(f + 1, last);
+  x_.resize(nv);
+  v_.assign(nv, Vec3d::Zero());
+  for (int v = 0; v < nv; ++v) {
+    const Vec3d a = s.positions[size_t(f) * nv + v].cast<double>(), b = s.positions[size_t(g) * nv + v].cast<double>();
+    x_[v] = a + w * (b - a);
+    if (playing) v_[v] = (b - a) * s.fps;
+  }
+  featureNormals(x_, s.triangles, s.twin, normals_);
+  lo = hi = x_.empty() ? Vec3::Zero() : Vec3(x_[0].cast<float>());
+  for (int v = 0; v < nv; ++v) {
+    lo = lo.cwiseMin(x_[v].cast<float>());
+    hi = hi.cwiseMax(x_[v].cast<float>());
+    maxSpeed = std::max(maxSpeed, static_cast<float>(v_[v].norm()));
+  }
+  for (size_t k = 0; k < s.triangles.size(); ++k) {
+    if (!(normals_.face[k].squaredNorm() > 0.0)) continue;  // a collapsed triangle: its neighbours hold its points
+    const auto& tri = s.triangles[k];
+    tree_->triangles.emplace_back(point(x_[tri[0]]), point(x_[tri[1]]), point(x_[tri[2]]));
+    tree_->ids.push_back(static_cast<int>(k));
+  }
+  tree_->tree.rebuild(tree_->triangles.cbegin(), tree_->triangles.cend());
+  if (!tree_->triangles.empty()) tree_->tree.accelerate_distance_queries();  // built now, not by the first query
+}
+
+MeshSnapshot::~MeshSnapshot() = default;
+
+float MeshSnapshot::distance(const Vec3& p, Vec3* normal, Vec3* velocity) const {
+  if (tree_->triangles.empty()) {
+    if (normal) *normal = Vec3(0, 1, 0);
+    if (velocity) *velocity = Vec3::Zero();
+    return 1.0e30f;
+  }
+  const Vec3d pd = p.cast<double>();
+  const auto hit = tree_->tree.closest_point_and_primitive(point(pd));
+  const int t = tree_->ids[size_t(hit.second - tree_->triangles.cbegin())];
+  NearestOnMesh best;
+  nearerTriangle(x_, sequence_->triangles, normals_, t, pd, best);
+  const double dist = std::sqrt(best.dist2);
+  if (normal) {
+    const Vec3d n = dist > 1e-9 ? Vec3d(best.sign * (pd - best.point) / dist) : best.pseudoNormal.normalized();
+    *normal = n.squaredNorm() > 0.0 ? Vec3(n.cast<float>()) : Vec3(0, 1, 0);
+  }
+  if (velocity) {
+    const auto& tri = sequence_->triangles[t];
+    const Vec3d b = barycentric(best.point, x_[tri[0]], x_[tri[1]], x_[tri[2]]);
+    *velocity = (b[0] * v_[tri[0]] + b[1] * v_[tri[1]] + b[2] * v_[tri[2]]).cast<float>();
+  }
+  return static_cast<float>(best.sign * dist);
+}
+
+TriangleMesh MeshSnapshot::surface() const {
+  TriangleMesh m;
+  m.vertices.reserve(x_.size());
+  for (const Vec3d& x : x_) m.vertices.push_back(x.cast<float>());
+  m.triangles = sequence_->triangles;
+  return m;
+}
+
+}  // namespace soak
