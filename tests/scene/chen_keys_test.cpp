@@ -13,6 +13,7 @@
 #include "world/garment_mesh.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -200,6 +201,42 @@ TEST(GarmentScene, MeshColliderFromAnObjFile) {
   EXPECT_HAS(loadError(scene, {"colliders.0.path=nowhere.obj"}),
              "at colliders[0].path: expected the path of an existing OBJ file, got \"nowhere.obj\"");
   EXPECT_HAS(loadError(scene, {"colliders.0.radius=1"}), "'radius' is not a key of a mesh collider");
+}
+
+// a "meshSequence" collider reads its frames by the pattern (scaled, played at fps from start, moved by
+// its pose); a missing fps, no frame found, a range that is not complete or a key of another type is
+// refused naming the path
+TEST(GarmentScene, MeshSequenceColliderFromObjFrames) {
+  const std::string dir = ::testing::TempDir() + "/soak_sequence_scene";
+  std::filesystem::create_directories(dir);
+  for (int f = 1; f <= 3; ++f) {
+    // a cube of 100 cm (scale 0.01: 1 m) whose top rises 10 cm a frame
+    std::ofstream obj(dir + "/lift_" + std::to_string(f) + ".obj");
+    for (int k = 0; k < 8; ++k)
+      obj << "v " << (k & 1 ? 50 : -50) << " " << (k & 2 ? 50 + 10 * (f - 1) : -50) << " " << (k & 4 ? 50 : -50) << "\n";
+    obj << "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\n"
+           "f 2 4 6\nf 4 8 6\n";
+  }
+  const std::string scene = R"({"colliders": [{"name": "lift", "type": "meshSequence", "path": ")" + dir +
+                            R"(/lift_#.obj", "fps": 10, "start": 0.5, "scale": 0.01, "position": [0, 1, 0]}],
+    "emitters": [{"type": "block", "min": [-0.1, 2, -0.1], "max": [0.1, 2.2, 0.1]}]})";
+  const Scene s = fromString(scene);
+  ASSERT_EQ(s.model.colliders.size(), 1u);
+  const Collider& c = s.model.colliders[0];
+  EXPECT_EQ(c.shape, ColliderShape::MeshSequence);
+  ASSERT_TRUE(c.sequence != nullptr);
+  // the top at y = 1.5 until t = 0.5, then rising 1 m/s to 1.7 at t = 0.7
+  for (const auto& [t, top] : {std::pair{0.0, 1.5f}, {0.55, 1.55f}, {0.65, 1.65f}, {3.0, 1.7f}})
+    EXPECT_NEAR(colliderDistance(c, colliderPose(c, t), Vec3(0, 2.0f, 0), nullptr), 2.0f - top, 1e-5f) << t;
+  EXPECT_NEAR(colliderVelocity(c, colliderPose(c, 0.6), Vec3(0, 1.61f, 0)).y(), 1.0f, 1e-4f);
+  EXPECT_HAS(loadError(scene, {"colliders.0.fps=0"}), "at colliders[0].fps: expected a number > 0");
+  EXPECT_HAS(loadError(scene, {"colliders.0.path=" + dir + "/lift_##.obj"}), "at colliders[0].path: ");
+  EXPECT_HAS(loadError(scene, {"colliders.0.path=" + dir + "/lift_##.obj"}), "found none");
+  EXPECT_HAS(loadError(scene, {"colliders.0.lastFrame=4"}), "lift_4.obj: at mesh sequence: expected frame 4");
+  EXPECT_HAS(loadError(scene, {"colliders.0.firstFrame=3", "colliders.0.lastFrame=2"}),
+             "at colliders[0].lastFrame: expected a frame >= firstFrame (3), got 2");
+  EXPECT_HAS(loadError(scene, {"colliders.0.radius=1"}), "'radius' is not a key of a meshSequence collider");
+  std::filesystem::remove_all(dir);
 }
 
 // every key of a rain emitter reaches the Emitter (halfExtents are x and z, the direction is normalised);

@@ -191,7 +191,7 @@ TEST(SceneErrors, BadEnumListsTheAllowedValues) {
   EXPECT_HAS(loadError(R"({"cloth": [], "emitters": [{"type": "block", "min": [0,0,0], "max": [1,1,1]}],
                            "colliders": [{"type": "cube"}]})"),
              "test.json: at colliders[0].type: expected one of \"plane\", \"box\", \"container\", \"sphere\", "
-             "\"capsule\", \"mesh\", \"mannequin\", got the string \"cube\"");
+             "\"capsule\", \"mesh\", \"mannequin\", \"meshSequence\", got the string \"cube\"");
   EXPECT_HAS(errorWith("emitters.0.type=hose"), "at emitters[0].type: expected one of \"block\", \"jet\"");
   EXPECT_HAS(errorWith("cloth.0.mesh.type=sphere"), "at cloth[0].mesh.type: expected one of \"rectangle\", \"obj\"");
 }
