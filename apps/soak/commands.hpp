@@ -1,5 +1,6 @@
 // the subcommands of the soak program; each returns the process exit code
 #pragma once
+#include <soak/body_export.hpp>
 #include <soak/render.hpp>
 
 #include <string>
@@ -97,6 +98,14 @@ struct RenderCliOptions {
   CLI::Option *fovOpt = nullptr, *azimuthOpt = nullptr, *elevationOpt = nullptr, *zoomOpt = nullptr;
   bool quiet = false;
 };
+// `soak export-body` (apps/soak/render.cpp): the scene's mannequin as an OBJ sequence
+struct ExportBodyCliOptions {
+  BodyExportOptions options;
+  bool quiet = false;
+};
+CLI::App* addExportBodyCommand(CLI::App& app, ExportBodyCliOptions& o);
+int exportBodyCommand(const ExportBodyCliOptions& o);
+
 struct SurfaceCliOptions {
   SurfaceOptions options;
   bool quiet = false;

@@ -153,6 +153,8 @@ int realMain(int argc, char** argv) {
   CLI::App* renderCmd = addRenderCommand(app, render);
   SurfaceCliOptions surface;
   CLI::App* surfaceCmd = addSurfaceCommand(app, surface);
+  ExportBodyCliOptions exportBodyOpts;
+  CLI::App* exportBodyCmd = addExportBodyCommand(app, exportBodyOpts);
 
   try {
     app.parse(argc, argv);
@@ -165,6 +167,7 @@ int realMain(int argc, char** argv) {
   if (*valCmd) return validateCommand(val);
   if (*renderCmd) return renderCommand(render);
   if (*surfaceCmd) return surfaceCommand(surface);
+  if (*exportBodyCmd) return exportBodyCommand(exportBodyOpts);
   if (*sweepCmd) return sweepCommand(sweep);
   return benchCommand(bench);
 }

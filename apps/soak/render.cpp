@@ -1,4 +1,4 @@
-// `soak render` and `soak surface`: options, a progress bar and a summary around src/render/
+// `soak render`, `soak surface` and `soak export-body`: options, a progress bar and a summary around src/render/
 #include <soak/render.hpp>
 
 #include <fmt/format.h>
@@ -104,6 +104,37 @@ CLI::App* addSurfaceCommand(CLI::App& app, SurfaceCliOptions& o) {
   cmd->add_flag("!--no-vdb", o.options.vdb, "no water_surface_NNNN.vdb");
   cmd->add_flag("-q,--quiet", o.quiet, "no progress and no summary");
   return cmd;
+}
+
+CLI::App* addExportBodyCommand(CLI::App& app, ExportBodyCliOptions& o) {
+  BodyExportOptions& b = o.options;
+  CLI::App* cmd = app.add_subcommand("export-body", "write a scene's mannequin, moving, as an OBJ sequence of one topology");
+  cmd->add_option("scene", b.scene, "scene file (JSON) with a mannequin collider")->required();
+  cmd->add_option("-o,--out", b.outDir, "folder for body_NNNN.obj")->required();
+  cmd->add_option("--collider", b.collider, "the mannequin's name (default: the scene's first)");
+  cmd->add_option("--frames", b.frames, "frames to write (default: the scene's output.frames + 1, its frames 0 .. N)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--fps", b.fps, "frames per second (default: the scene's, 1 / (stepsPerFrame dt))")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--cell", b.cellSize, "cell size of the grid the skin is meshed on, m (default 0.01)")
+      ->check(CLI::Range(0.001, 1.0));
+  cmd->add_option("--set", b.overrides, "override a scene value, key=value (repeatable)")->allow_extra_args(false)->take_all();
+  cmd->add_flag("--overwrite", b.overwrite, "replace a sequence already in the folder");
+  cmd->add_flag("-q,--quiet", o.quiet, "no progress and no summary");
+  return cmd;
+}
+
+int exportBodyCommand(const ExportBodyCliOptions& o) {
+  Progress bar(0, !o.quiet);
+  const BodyExport res = exportBody(o.options, [&bar](int done, int total) { bar.updateItems("frame", done, total); });
+  bar.finish();
+  if (!o.quiet) {
+    std::printf("soak: wrote %d frames of %zu vertices, %zu triangles as %s in %s\n", res.frames, res.vertices,
+                res.triangles, res.pattern.c_str(), Progress::formatDuration(bar.seconds()).c_str());
+    std::printf("soak: as a collider: {\"type\": \"meshSequence\", \"path\": \"%s\", \"fps\": %.6g}\n",
+                res.pattern.c_str(), res.fps);
+  }
+  return kExitOk;
 }
 
 int renderCommand(RenderCliOptions& o) {

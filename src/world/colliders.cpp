@@ -131,7 +131,7 @@ float sequenceDistance(const ColliderPose& pose, const Vec3& p, Vec3* normal, Ve
 // their normals and surface velocities blended with the same weights (the gradient's chain rule);
 // `slope`: the gradient's length (<= 1)
 float blendDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal, Vec3* velocity,
-                    float* slope = nullptr) {
+                    float* slope = nullptr, std::vector<float>* weights = nullptr) {
   const size_t count = c.parts ? c.parts->size() : 0;
   if (count == 0 || pose.parts.size() != count) {
     if (normal) *normal = Vec3(0, 1, 0);
@@ -141,6 +141,7 @@ float blendDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, 
   Vec3 grad, vel = Vec3::Zero();
   float d = colliderDistance((*c.parts)[0], pose.parts[0], p, &grad);
   if (velocity) vel = pose.parts[0].velocityAt(p);
+  if (weights) weights->assign(count, 0.0f), (*weights)[0] = 1.0f;
   for (size_t k = 1; k < count; ++k) {
     Vec3 nk;
     const float dk = colliderDistance((*c.parts)[k], pose.parts[k], p, &nk);
@@ -149,6 +150,10 @@ float blendDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, 
     d = smoothMin(d, dk, c.blendRadius, &w);
     grad += w * (nk - grad);
     if (velocity) vel += w * (pose.parts[k].velocityAt(p) - vel);
+    if (weights) {  // each part's share of the blend: the same step for every part so far
+      for (size_t j = 0; j < k; ++j) (*weights)[j] *= 1.0f - w;
+      (*weights)[k] = w;
+    }
   }
   if (normal) {
     // the gradient of a blend of unit normals is shorter than 1, and vanishes only where two
@@ -294,6 +299,14 @@ Vec3 colliderVelocity(const Collider& c, const ColliderPose& pose, const Vec3& p
   if (c.shape == ColliderShape::Body) blendDistance(c, pose, p, nullptr, &v);
   if (c.shape == ColliderShape::MeshSequence) sequenceDistance(pose, p, nullptr, &v);
   return v;
+}
+
+float bodyPartWeights(const Collider& c, const ColliderPose& pose, const Vec3& p, std::vector<float>& weights) {
+  if (c.shape != ColliderShape::Body) {
+    weights.clear();
+    return colliderDistance(c, pose, p, nullptr);
+  }
+  return blendDistance(c, pose, p, nullptr, nullptr, nullptr, &weights);
 }
 
 float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3& p) {

@@ -57,6 +57,10 @@ bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& 
 // or for a Body its parts' fields blended with the weights of its normal (a point of the skin between
 // two bones moves as a mix of both); a MeshSequence adds its nearest surface point's own motion
 Vec3 colliderVelocity(const Collider& c, const ColliderPose& pose, const Vec3& p);
+// a Body's distance at p and each part's share of its blend there (they sum to 1; the weights of its
+// normal and of its skin velocity, colliderVelocity); another shape: its distance and no weights
+float bodyPartWeights(const Collider& c, const ColliderPose& pose, const Vec3& p, std::vector<float>& weights);
+
 // an upper bound of |colliderVelocity(c, pose, p)| that costs no distance (a Body: its fastest part;
 // a MeshSequence: its fastest vertex on top of the rigid motion)
 float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3& p);

@@ -5,6 +5,7 @@
 #include "io/file.hpp"
 #include "io/ply.hpp"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -138,6 +139,45 @@ TEST(CliValidate, EveryShippedSceneIsValid) {
     }
   }
   EXPECT_GE(scenes, 4);
+}
+
+// `soak export-body` writes the scene's mannequin as body_NNNN.obj for its frames 0 .. N at its frame
+// rate, says how to use them, refuses to overwrite unasked and names a missing collider; the files
+// play back as a meshSequence collider
+TEST(CliExportBody, WritesTheMannequinAsAnObjSequence) {
+  const Cli cli("export_body");
+  const std::string scene = cli.writeScene("body.json", R"({
+    "name": "body", "description": "cli test: a small mannequin under a small cloth",
+    "solver": {"dt": 0.01, "substeps": 1, "domain": {"min": [-1, -0.5, -1], "max": [1, 2, 1]}},
+    "output": {"frames": 3, "stepsPerFrame": 2},
+    "colliders": [{"name": "bob", "type": "mannequin", "height": 1.0}],
+    "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1.5, 0], "size": [0.2, 0.2],
+               "resolution": [5, 5], "axisU": [1, 0, 0], "axisV": [0, 0, 1]}}]})");
+  const fs::path out = cli.dir() / "seq";
+  const Result r = cli.run("export-body '" + scene + "' -o '" + out.string() + "' --cell 0.03");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int f = 1; f <= 4; ++f) EXPECT_TRUE(fs::exists(out / fmt::format("body_{:04d}.obj", f))) << f;
+  EXPECT_FALSE(fs::exists(out / "body_0005.obj"));
+  EXPECT_NE(r.out.find("wrote 4 frames"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(R"("type": "meshSequence", "path": ")" + (out / "body_####.obj").string() + R"(", "fps": 50})"),
+            std::string::npos)
+      << r.out;
+  const Result again = cli.run("export-body '" + scene + "' -o '" + out.string() + "' --cell 0.03");
+  EXPECT_EQ(again.code, 1);
+  EXPECT_NE(again.err.find("body_0001.obj: at export-body: the file exists; pass --overwrite"), std::string::npos)
+      << again.err;
+  EXPECT_EQ(cli.run("export-body '" + scene + "' -o '" + out.string() + "' --cell 0.03 --overwrite -q").code, 0);
+  const Result nobody = cli.run("export-body '" + scene + "' -o '" + out.string() + "' --collider alice");
+  EXPECT_NE(nobody.err.find("expected a mannequin collider named 'alice'"), std::string::npos) << nobody.err;
+  const std::string played = cli.writeScene("played.json", R"({
+    "name": "played", "description": "cli test: the exported body as a mesh sequence",
+    "solver": {"dt": 0.01, "substeps": 1, "domain": {"min": [-1, -0.5, -1], "max": [1, 2, 1]}},
+    "output": {"frames": 3, "stepsPerFrame": 2},
+    "colliders": [{"name": "bob", "type": "meshSequence", "path": "seq/body_####.obj", "fps": 50}],
+    "cloth": [{"name": "sheet", "mesh": {"type": "rectangle", "center": [0, 1.5, 0], "size": [0.2, 0.2],
+               "resolution": [5, 5], "axisU": [1, 0, 0], "axisV": [0, 0, 1]}}]})");
+  const Result valid = cli.run("validate '" + played + "'");
+  EXPECT_EQ(valid.code, 0) << valid.err;
 }
 
 TEST(CliValidate, SummaryCountsParticlesAndPieces) {
