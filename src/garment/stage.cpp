@@ -155,13 +155,14 @@ GarmentShape garmentShape(const Model& model, const State& state) {
   GarmentShape g;
   const std::vector<float> wet = clothWetness(model, state);
   double lowest = std::numeric_limits<double>::infinity(), height = 0.0, distance = 0.0, saturation = 0.0;
+  const PosedBody body(model.colliders, state.time);
   for (const ClothPiece& piece : model.pieces) {
     if (piece.solver != ClothSolver::Implicit && !piece.wetByContact) continue;
     for (int i = piece.firstParticle; i < piece.firstParticle + piece.particleCount; ++i) {
       const Vec3& x = state.particles.x[size_t(i)];
       lowest = std::min(lowest, double(x.y()));
       height += x.y();
-      if (!model.colliders.empty()) distance += bodyDistance(model.colliders, state.time, x, nullptr);
+      if (!model.colliders.empty()) distance += body.distance(x, nullptr);
       saturation += wet[size_t(i)];
       ++g.vertices;
     }

@@ -421,11 +421,16 @@ void triangulate(Garment& g, const Lattice& L, const LatticeVertices& lv, const 
 
 }  // namespace
 
-float bodyDistance(const std::vector<Collider>& body, double t, const Vec3& p, Vec3* normal) {
+PosedBody::PosedBody(const std::vector<Collider>& body, double t) : colliders(&body) {
+  poses.reserve(body.size());
+  for (const Collider& c : body) poses.push_back(colliderPose(c, t));
+}
+
+float PosedBody::distance(const Vec3& p, Vec3* normal) const {
   float best = 1e30f;
-  for (const Collider& c : body) {
+  for (size_t c = 0; c < colliders->size(); ++c) {
     Vec3 n = Vec3::UnitY();
-    const float d = colliderDistance(c, colliderPose(c, t), p, &n);
+    const float d = colliderDistance((*colliders)[c], poses[c], p, &n);
     if (d < best) {
       best = d;
       if (normal) *normal = n;
@@ -434,25 +439,31 @@ float bodyDistance(const std::vector<Collider>& body, double t, const Vec3& p, V
   return best;
 }
 
+float bodyDistance(const std::vector<Collider>& body, double t, const Vec3& p, Vec3* normal) {
+  return PosedBody(body, t).distance(p, normal);
+}
+
 std::vector<int> verticesInsideBody(const TriangleMesh& mesh, const std::vector<Collider>& body, double t,
                                     float margin) {
   std::vector<int> inside;
+  const PosedBody posed(body, t);
   for (int v = 0; v < static_cast<int>(mesh.vertices.size()); ++v)
-    if (bodyDistance(body, t, mesh.vertices[v], nullptr) < margin - 1e-5f) inside.push_back(v);
+    if (posed.distance(mesh.vertices[v], nullptr) < margin - 1e-5f) inside.push_back(v);
   return inside;
 }
 
 size_t pushOutOfBody(TriangleMesh& mesh, const std::vector<Collider>& body, double t, float margin, int iterations) {
   size_t left = 0;
+  const PosedBody posed(body, t);
   for (Vec3& x : mesh.vertices) {
     for (int it = 0; it < iterations; ++it) {
       Vec3 n = Vec3::UnitY();
-      const float d = bodyDistance(body, t, x, &n);
+      const float d = posed.distance(x, &n);
       if (d >= margin) break;
       // a little past the margin so rounding leaves it outside
       x += (margin - d + 1e-5f) * n;
     }
-    if (bodyDistance(body, t, x, nullptr) >= margin - 1e-5f) continue;
+    if (posed.distance(x, nullptr) >= margin - 1e-5f) continue;
     // stuck in a crease where two parts push it back and forth: the shortest way out along the 26
     // lattice directions, in 2 mm steps up to half a metre
     float bestS = 1e30f;
@@ -463,14 +474,14 @@ size_t pushOutOfBody(TriangleMesh& mesh, const std::vector<Collider>& body, doub
           if (dx == 0 && dy == 0 && dz == 0) continue;
           const Vec3 dir = Vec3(static_cast<float>(dx), static_cast<float>(dy), static_cast<float>(dz)).normalized();
           for (float s = 0.002f; s < std::min(bestS, 0.5f); s += 0.002f)
-            if (bodyDistance(body, t, x + s * dir, nullptr) >= margin) {
+            if (posed.distance(x + s * dir, nullptr) >= margin) {
               bestS = s;
               best = x + s * dir;
               break;
             }
         }
     x = best;
-    if (bodyDistance(body, t, x, nullptr) < margin - 1e-5f) ++left;
+    if (posed.distance(x, nullptr) < margin - 1e-5f) ++left;
   }
   return left;
 }

@@ -4,6 +4,7 @@
 #include <soak/model.hpp>
 
 #include "world/mesh.hpp"
+#include "world/colliders.hpp"
 #include "world/mannequin.hpp"
 
 #include <string>
@@ -43,7 +44,17 @@ struct Garment {
 Garment buildGarment(const MannequinParams& body, const MannequinPose& pose, const GarmentPattern& params,
                      const std::string& source = "garment");
 
-// the union's signed distance (m) at time t, with the nearest collider's outward normal
+// the body's colliders posed once at time t, for many queries (a mesh sequence builds its surface
+// tree when posed)
+struct PosedBody {
+  PosedBody(const std::vector<Collider>& body, double t);
+  // the union's signed distance (m), with the nearest collider's outward normal (may be null)
+  float distance(const Vec3& p, Vec3* normal) const;
+  const std::vector<Collider>* colliders;
+  std::vector<ColliderPose> poses;
+};
+
+// PosedBody(body, t).distance(p, normal): for one query
 float bodyDistance(const std::vector<Collider>& body, double t, const Vec3& p, Vec3* normal);
 
 // indices of the vertices closer to the body than `margin` (minus 1e-5 m for rounding)
