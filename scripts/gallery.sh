@@ -7,7 +7,7 @@
 #   scripts/gallery.sh [--work DIR] [--fresh] [STILL...]
 #
 # STILL: any of the names below (default: all), e.g. `scripts/gallery.sh fig4 fig5 fig9`.
-#   fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments sweep
+#   fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments obj_body sweep
 # --work DIR: where the runs and renders go (default /tmp/soak-gallery). A run already there with the
 #   frames a still needs is reused (its run.json must say status ok and at least those frames, and be
 #   newer than the scene file and every pattern file); pass --fresh to run every scene again.
@@ -24,7 +24,7 @@ threads="${THREADS:-2}"
 work=/tmp/soak-gallery
 fresh=0
 stills=()
-all=(fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments sweep)
+all=(fig1 fig3a fig3b fig4 fig5 fig6a fig6b fig9 dam_break drape_sphere chen_fig8 chen_fig9 garments obj_body sweep)
 while [ $# -gt 0 ]; do
   case "$1" in
     --work) work="$2"; shift 2 ;;
@@ -156,6 +156,18 @@ still_chen_fig9() {
 still_garments() {
   still garment_dress_rain 300 --particles
   still garment_skirt 90
+}
+# the moving-body shirt at 3 s (arms raised) on the mannequin and on its OBJ sequence (soak export-body)
+still_obj_body() {
+  "$soak" export-body scenes/garment_tshirt_moving.json -o scenes/obj_body/frames --overwrite --quiet
+  mkdir -p "$work/obj_body" "$work/render/obj_body"
+  local scene
+  for scene in garment_tshirt_moving obj_body/garment_tshirt_obj_body; do
+    run "$scene" 90
+    render "$scene" 90 "$work/render/$scene.png" --particles --camera 0.9,1.6,2.0 --look-at 0,1.2,0
+  done
+  pair "$work/render/garment_tshirt_moving.png" "mannequin, t = 3 s" \
+    "$work/render/obj_body/garment_tshirt_obj_body.png" "its OBJ sequence, t = 3 s" garment_obj_body
 }
 # the contact sheet of sweeps/fig5c_wicking.json (docs/sweeps.md; its complete variants are reused)
 still_sweep() {
