@@ -13,13 +13,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// relative file paths in the scene ("mesh": {"path": ...}) made absolute against baseDir
+// relative file paths in the scene ("mesh": {"path": ...}) made absolute against baseDir: an existing
+// file, or a mesh sequence's pattern ('#' for the frame number) in an existing folder
 void resolvePaths(nlohmann::json& v, const fs::path& baseDir) {
   if (v.is_object()) {
     for (auto it = v.begin(); it != v.end(); ++it) {
       if (it.key() == "path" && it->is_string()) {
         const fs::path p = it->get<std::string>();
-        if (p.is_relative() && fs::exists(baseDir / p)) *it = fs::absolute(baseDir / p).lexically_normal().string();
+        const bool pattern = p.filename().string().find('#') != std::string::npos;
+        const bool found = fs::exists(baseDir / p) || (pattern && fs::is_directory((baseDir / p).parent_path()));
+        if (p.is_relative() && found) *it = fs::absolute(baseDir / p).lexically_normal().string();
       } else {
         resolvePaths(*it, baseDir);
       }

@@ -107,6 +107,9 @@ MeshSequence makeMeshSequence(const std::vector<TriangleMesh>& frames, const std
     if (!(n0.face[t].squaredNorm() > 0.0))
       throw errorAt(nameOf(0), fmt::format("mesh sequence, frame 0, triangle {}", t), "degenerate triangle (zero area)");
   s.thickness = medianEdgeLength(s);
+  s.vertexTriangle.assign(size_t(s.vertexCount), -1);
+  for (size_t t = 0; t < s.triangles.size(); ++t)
+    for (int v : s.triangles[t]) s.vertexTriangle[size_t(v)] = static_cast<int>(t);
   return s;
 }
 
@@ -204,8 +207,15 @@ MeshSequence loadMeshSequence(const std::vector<std::string>& files, double fps,
 struct MeshSnapshot::Tree {
   KernelTriangles triangles;  // the non-degenerate triangles at this time
   std::vector<int> ids;       // their index in the sequence
+  std::vector<int> slot;      // per sequence triangle: its index in `triangles`, -1 when degenerate
   AabbTree tree;
 };
+
+namespace {
+
+constexpr int64_t kMaxHintCells = int64_t(1) << 21;
+
+}  // namespace
 
 MeshSnapshot::MeshSnapshot(std::shared_ptr<const MeshSequence> sequence, double t)
     : sequence_(std::move(sequence)), tree_(std::make_unique<Tree>()) {
@@ -232,14 +242,53 @@ MeshSnapshot::MeshSnapshot(std::shared_ptr<const MeshSequence> sequence, double 
     hi = hi.cwiseMax(x_[v].cast<float>());
     maxSpeed = std::max(maxSpeed, static_cast<float>(v_[v].norm()));
   }
+  tree_->slot.assign(s.triangles.size(), -1);
   for (size_t k = 0; k < s.triangles.size(); ++k) {
     if (!(normals_.face[k].squaredNorm() > 0.0)) continue;  // a collapsed triangle: its neighbours hold its points
     const auto& tri = s.triangles[k];
+    tree_->slot[k] = static_cast<int>(tree_->triangles.size());
     tree_->triangles.emplace_back(point(x_[tri[0]]), point(x_[tri[1]]), point(x_[tri[2]]));
     tree_->ids.push_back(static_cast<int>(k));
   }
   tree_->tree.rebuild(tree_->triangles.cbegin(), tree_->triangles.cend());
-  if (!tree_->triangles.empty()) tree_->tree.accelerate_distance_queries();  // built now, not by the first query
+  // a query with no vertex near it falls back on CGAL's own hint (a k-d tree it builds, thread-safe,
+  // on the first such query); the grid's hints are cheaper to make than that tree and as good
+  hintCell_ = std::max(4.0f * s.thickness, 1e-4f);
+  int64_t cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    hintDims_[a] = static_cast<int>(std::min((hi[a] - lo[a]) / hintCell_, 4096.0f)) + 1;
+    cells *= hintDims_[a];
+  }
+  if (cells > kMaxHintCells) return;  // no grid: every query takes CGAL's hint
+  hintGrid_.assign(size_t(cells), -1);
+  for (int v = 0; v < nv; ++v) {
+    const int t = s.vertexTriangle[size_t(v)];
+    if (t < 0 || tree_->slot[size_t(t)] < 0) continue;
+    int64_t c = 0;
+    for (int a = 2; a >= 0; --a)
+      c = c * hintDims_[a] + std::clamp(static_cast<int>((float(x_[v][a]) - lo[a]) / hintCell_), 0, hintDims_[a] - 1);
+    hintGrid_[size_t(c)] = v;
+  }
+}
+
+int MeshSnapshot::hintVertex(const Vec3& p) const {
+  if (hintGrid_.empty()) return -1;
+  std::array<int, 3> cell;
+  for (int a = 0; a < 3; ++a) {
+    cell[a] = static_cast<int>(std::floor((p[a] - lo[a]) / hintCell_));
+    if (cell[a] < -1 || cell[a] > hintDims_[a]) return -1;  // more than a cell outside the box
+  }
+  // the point's cell, then its 26 neighbours
+  for (int ring = 0; ring <= 1; ++ring)
+    for (int dz = -ring; dz <= ring; ++dz)
+      for (int dy = -ring; dy <= ring; ++dy)
+        for (int dx = -ring; dx <= ring; ++dx) {
+          const int i = cell[0] + dx, j = cell[1] + dy, k = cell[2] + dz;
+          if (i < 0 || j < 0 || k < 0 || i >= hintDims_[0] || j >= hintDims_[1] || k >= hintDims_[2]) continue;
+          const int v = hintGrid_[size_t(i + int64_t(hintDims_[0]) * (j + int64_t(hintDims_[1]) * k))];
+          if (v >= 0) return v;
+        }
+  return -1;
 }
 
 MeshSnapshot::~MeshSnapshot() = default;
@@ -251,7 +300,12 @@ float MeshSnapshot::distance(const Vec3& p, Vec3* normal, Vec3* velocity) const 
     return 1.0e30f;
   }
   const Vec3d pd = p.cast<double>();
-  const auto hit = tree_->tree.closest_point_and_primitive(point(pd));
+  const int hv = hintVertex(p);
+  const auto hit = hv < 0 ? tree_->tree.closest_point_and_primitive(point(pd))
+                          : tree_->tree.closest_point_and_primitive(
+                                point(pd), {point(x_[size_t(hv)]),
+                                            tree_->triangles.cbegin() +
+                                                tree_->slot[size_t(sequence_->vertexTriangle[size_t(hv)])]});
   const int t = tree_->ids[size_t(hit.second - tree_->triangles.cbegin())];
   NearestOnMesh best;
   nearerTriangle(x_, sequence_->triangles, normals_, t, pd, best);

@@ -2,13 +2,15 @@
 // the usual export of a character's animation from Blender, Houdini or Maya as one OBJ per frame.
 // Positions are interpolated linearly between frames; the surface moves with the vertices'
 // velocities, interpolated over each triangle; distances are exact to the interpolated triangles
-// (a CGAL AABB tree built for each pose), signed by angle-weighted pseudo-normals (mesh_distance.hpp)
+// (a CGAL AABB tree built for each pose, its search started from a vertex near the query found in a
+// coarse grid), signed by angle-weighted pseudo-normals (mesh_distance.hpp)
 #pragma once
 #include <soak/model.hpp>
 
 #include "world/mesh.hpp"
 #include "world/mesh_distance.hpp"
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +27,7 @@ struct MeshSequence {
   // m: the median edge length of frame 0, taken as the thinnest the surface is (how finely a fast
   // particle's path is sampled for a crossing, collider_contact.cpp)
   float thickness = 0.0f;
+  std::vector<int> vertexTriangle;  // a triangle holding each vertex (-1: none), for search hints
 };
 
 // most positions (vertices x frames) a sequence may hold: 2^26, 768 MiB of floats
@@ -70,10 +73,17 @@ class MeshSnapshot {
 
  private:
   struct Tree;
+  // a vertex near p whose triangle is in the tree, or -1: the search's first guess
+  int hintVertex(const Vec3& p) const;
+
   std::shared_ptr<const MeshSequence> sequence_;
   std::vector<Vec3d> x_, v_;
   FeatureNormals normals_;
   std::unique_ptr<Tree> tree_;
+  // one vertex per cell of a grid over the box (-1: none), cells of 4 median edges
+  float hintCell_ = 1.0f;
+  std::array<int, 3> hintDims_{0, 0, 0};
+  std::vector<int> hintGrid_;
 };
 
 }  // namespace soak

@@ -37,3 +37,14 @@ TEST(SceneAsRun, OverridesAppliedAndMeshPathsMadeAbsolute) {
   EXPECT_THROW(sceneAsRun((dir / "missing.json").string()), Error);
   fs::remove_all(dir);
 }
+
+// a mesh sequence's file pattern is made absolute too (render and resume read the run's scene.json)
+TEST(SceneAsRun, AMeshSequencePatternIsMadeAbsolute) {
+  const fs::path dir = fs::temp_directory_path() / ("soak_as_run_seq_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "frames");
+  std::ofstream(dir / "scene.json") << R"({"colliders": [{"type": "meshSequence", "path": "frames/body_####.obj",
+    "fps": 30}], "cloth": []})";
+  const nlohmann::json doc = nlohmann::json::parse(sceneAsRun((dir / "scene.json").string()));
+  EXPECT_EQ(doc["colliders"][0]["path"].get<std::string>(), (dir / "frames" / "body_####.obj").string());
+  fs::remove_all(dir);
+}
