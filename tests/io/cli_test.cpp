@@ -178,6 +178,11 @@ TEST(CliExportBody, WritesTheMannequinAsAnObjSequence) {
                "resolution": [5, 5], "axisU": [1, 0, 0], "axisV": [0, 0, 1]}}]})");
   const Result valid = cli.run("validate '" + played + "'");
   EXPECT_EQ(valid.code, 0) << valid.err;
+  // the shipped OBJ-body scene (its frames are generated, so no other test loads it) is valid on them
+  const Result shipped = cli.run("validate '" + std::string(SOAK_SOURCE_DIR) +
+                                 "/scenes/obj_body/garment_tshirt_obj_body.json' --set 'colliders.0.path=" +
+                                 (out / "body_####.obj").string() + "'");
+  EXPECT_EQ(shipped.code, 0) << shipped.err;
 }
 
 TEST(CliValidate, SummaryCountsParticlesAndPieces) {
