@@ -189,12 +189,12 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
   });
 }
 
-// a vertex at x touching collider c along its outward normal nrm: the velocity into the collider is
-// removed and Coulomb friction (the fabric's mixed with the collider's) acts on the slip, with the
-// removed normal velocity as its impulse; x gives back the slip friction removed during the step
-void contactResponse(const Collider& collider, const ColliderPose& pose, const Vec3& nrm, float muFabric, float h,
-                     Vec3& x, Vec3& vel) {
-  const Vec3 vCol = colliderVelocity(collider, pose, x);
+// a vertex at x touching collider c (its surface moving at vCol) along its outward normal nrm: the
+// velocity into the collider is removed and Coulomb friction (the fabric's mixed with the
+// collider's) acts on the slip, with the removed normal velocity as its impulse; x gives back the
+// slip friction removed during the step
+void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm, float muFabric, float h, Vec3& x,
+                     Vec3& vel) {
   Vec3 rel = vel - vCol;
   const float dvn = std::max(-rel.dot(nrm), 0.0f);
   rel += dvn * nrm;  // the inward velocity is removed
@@ -228,10 +228,10 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
     const float muFabric = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
     bool contact = false;
     for (size_t c = 0; c < numColliders; ++c) {
-      Vec3 nrm;
-      if (!pushOutOf(model.colliders[c], poses[c], margin, x, &nrm)) continue;  // project out to the margin
+      Vec3 nrm, vCol;
+      if (!pushOutOf(model.colliders[c], poses[c], margin, x, &nrm, &vCol)) continue;  // project out to the margin
       contact = true;
-      contactResponse(model.colliders[c], poses[c], nrm, muFabric, h, x, vel);
+      contactResponse(model.colliders[c], vCol, nrm, muFabric, h, x, vel);
     }
     p.xPred[i] = x;
     p.v[i] = vel;
@@ -276,7 +276,8 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
       for (const auto& [u, free] : {std::pair{a, ma}, std::pair{b, mb}}) {
         if (!free) continue;
         x[u] += push;
-        contactResponse(model.colliders[c], poses[c], nrm, 0.0f, 0.0f, x[u], v[u]);  // frictionless: no slip removed
+        contactResponse(model.colliders[c], colliderVelocity(model.colliders[c], poses[c], x[u]), nrm, 0.0f, 0.0f, x[u],
+                        v[u]);  // frictionless: no slip removed
       }
       ++pushed;
     }
@@ -300,9 +301,9 @@ int selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vect
   for (int v = 0; v < g.count; ++v) {
     if (!w.self.moved[v] || w.invMass[v] == 0.0f) continue;
     for (size_t c = 0; c < numColliders; ++c) {
-      Vec3 nrm;
-      if (!pushOutOf(model.colliders[c], poses[c], margin, p.xPred[first + v], &nrm)) continue;
-      contactResponse(model.colliders[c], poses[c], nrm, 0.0f, 0.0f, p.xPred[first + v], p.v[first + v]);
+      Vec3 nrm, vCol;
+      if (!pushOutOf(model.colliders[c], poses[c], margin, p.xPred[first + v], &nrm, &vCol)) continue;
+      contactResponse(model.colliders[c], vCol, nrm, 0.0f, 0.0f, p.xPred[first + v], p.v[first + v]);
     }
   }
   return pushes;

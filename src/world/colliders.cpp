@@ -252,13 +252,24 @@ float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& 
   return d;
 }
 
-bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& x, Vec3* normal) {
+bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& x, Vec3* normal, Vec3* velocity) {
   Vec3 nrm;
+  if (c.shape == ColliderShape::MeshSequence) {
+    // one search for both: the push along the nearest point's normal keeps that nearest point
+    Vec3 v;
+    const float d = sequenceDistance(pose, x, &nrm, velocity ? &v : nullptr) - margin;
+    if (d >= 0.0f) return false;
+    x -= d * nrm;
+    *normal = nrm;
+    if (velocity) *velocity = v + pose.angularVelocity.cross(-d * nrm);  // the rigid field at the pushed x
+    return true;
+  }
   if (c.shape != ColliderShape::Body) {
     const float d = colliderDistance(c, pose, x, &nrm) - margin;
     if (d >= 0.0f) return false;
     x -= d * nrm;
     *normal = nrm;
+    if (velocity) *velocity = colliderVelocity(c, pose, x);
     return true;
   }
   // a Body: the root of s(x + t n) = margin along the start's normal n, bracketed from the Newton
@@ -291,6 +302,7 @@ bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& 
   }
   x += tOut * nrm;
   *normal = nrm;
+  if (velocity) *velocity = colliderVelocity(c, pose, x);
   return true;
 }
 

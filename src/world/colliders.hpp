@@ -46,12 +46,14 @@ ColliderPose keyframedPose(std::span<const Keyframe> keys, double t);
 float colliderDistance(const Collider& c, const ColliderPose& pose, const Vec3& p, Vec3* normal);
 
 // moves x out along the collider's normal to a distance >= margin; true when x was within the margin,
-// *normal the last push's normal. One push for the exact distances; a Body's smooth distance changes
+// *normal the last push's normal, *velocity (may be null) the collider's surface velocity at the new x
+// (colliderVelocity; a mesh sequence's from the same search as the push). One push for the exact distances; a Body's smooth distance changes
 // by |gradient| <= 1 per metre moved, so a push by the distance falls short where parts blend: its
 // push is found along the normal by a bracketed root search (kBodyPushes doublings, 4 kBodyPushes
 // regula falsi steps at most) and ends within 1e-3 margin beyond the margin
 constexpr int kBodyPushes = 4;
-bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& x, Vec3* normal);
+bool pushOutOf(const Collider& c, const ColliderPose& pose, float margin, Vec3& x, Vec3* normal,
+               Vec3* velocity = nullptr);
 
 // velocity (m/s) of the collider's surface material at world point p: the rigid field of the pose,
 // or for a Body its parts' fields blended with the weights of its normal (a point of the skin between

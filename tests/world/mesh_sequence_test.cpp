@@ -136,6 +136,22 @@ TEST(MeshSequence, KeysMoveTheSequenceRigidlyOnTop) {
   expectVec(hi, centre + Vec3::Constant(0.1f), 1e-5f);
 }
 
+// pushOutOf hands back the surface velocity from its own search: the same as colliderVelocity at the
+// pushed point, with the frames sliding the cube and the keys turning it (the rigid field moves with x)
+TEST(MeshSequence, APushGivesTheSurfaceVelocityAtThePushedPoint) {
+  Collider c = sequenceCollider({cubeMesh(0.1f), moved(cubeMesh(0.1f), Vec3(0.2f, 0, 0))}, 10.0);
+  c.keys = {Keyframe{0.0f, Vec3(0, 1, 0), Quat::Identity()},
+            Keyframe{1.0f, Vec3(0, 1, 0), Quat(Eigen::AngleAxisf(0.5f * float(M_PI), Vec3(0, 1, 0)))}};
+  const ColliderPose pose = colliderPose(c, 0.05);
+  ASSERT_GT(pose.angularVelocity.norm(), 1.0f);
+  for (const Vec3& start : {Vec3(0.1f, 1.11f, 0.02f), Vec3(0.05f, 1.05f, 0.0f), Vec3(0.22f, 1.0f, 0.03f)}) {
+    Vec3 x = start, n, v;
+    ASSERT_TRUE(pushOutOf(c, pose, 0.02f, x, &n, &v)) << start.transpose();
+    EXPECT_NEAR(colliderDistance(c, pose, x, nullptr), 0.02f, 1e-5f);
+    expectVec(v, colliderVelocity(c, pose, x), 1e-5f);
+  }
+}
+
 // a mesh wound inwards is turned outwards (by frame 0's volume); a triangle that collapses in a
 // later frame is skipped (its neighbours hold its points) and the distance stays exact
 TEST(MeshSequence, InwardWindingIsTurnedAndACollapsedTriangleIsSkipped) {
