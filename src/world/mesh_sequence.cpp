@@ -214,6 +214,9 @@ struct MeshSnapshot::Tree {
 namespace {
 
 constexpr int64_t kMaxHintCells = int64_t(1) << 21;
+// rings of cells searched for a hint: a point farther than about that many cells from every vertex
+// (a drop in the air between the arms) takes CGAL's own hint, whose k-d tree is built on first use
+constexpr int kHintRings = 4;
 
 }  // namespace
 
@@ -276,13 +279,14 @@ int MeshSnapshot::hintVertex(const Vec3& p) const {
   std::array<int, 3> cell;
   for (int a = 0; a < 3; ++a) {
     cell[a] = static_cast<int>(std::floor((p[a] - lo[a]) / hintCell_));
-    if (cell[a] < -1 || cell[a] > hintDims_[a]) return -1;  // more than a cell outside the box
+    if (cell[a] < -kHintRings || cell[a] >= hintDims_[a] + kHintRings) return -1;  // far outside the box
   }
-  // the point's cell, then its 26 neighbours
-  for (int ring = 0; ring <= 1; ++ring)
+  // the point's cell, then the rings of cells around it (a ring's inside was searched before it)
+  for (int ring = 0; ring <= kHintRings; ++ring)
     for (int dz = -ring; dz <= ring; ++dz)
       for (int dy = -ring; dy <= ring; ++dy)
         for (int dx = -ring; dx <= ring; ++dx) {
+          if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != ring) continue;
           const int i = cell[0] + dx, j = cell[1] + dy, k = cell[2] + dz;
           if (i < 0 || j < 0 || k < 0 || i >= hintDims_[0] || j >= hintDims_[1] || k >= hintDims_[2]) continue;
           const int v = hintGrid_[size_t(i + int64_t(hintDims_[0]) * (j + int64_t(hintDims_[1]) * k))];
