@@ -55,7 +55,7 @@ CameraSpec frameCamera(const Bounds& bounds, const CameraRequest& request, int w
 struct PovFrameInput {
   const Model* model = nullptr;                  // colliders
   std::vector<ColliderPose> poses;               // one per collider, at the frame's time
-  std::vector<const SurfaceMesh*> colliderMesh;  // per collider: the mesh of a Mesh collider, else null
+  std::vector<const SurfaceMesh*> colliderMesh;  // per collider: a mesh's, a body's or a sequence's surface (may be empty)
   const ClothFrame* cloth = nullptr;
   std::vector<Vec3> clothColor;  // per cloth vertex (0..1); empty: the plain fabric colour
   WaterStyle water = WaterStyle::Particles;

@@ -88,6 +88,32 @@ struct FrameJob {
   std::vector<SurfaceMesh> colliderMeshes;  // per collider (empty for non-mesh shapes)
 };
 
+// the colliders' surfaces at a frame's poses: a mesh's, meshed once (`fixed`); a Body's skin, meshed
+// at its pose with kBodyCells cells along its longest side; a mesh sequence's triangles at that time.
+// `posed` holds the ones made for this frame
+std::vector<const SurfaceMesh*> frameColliderMeshes(const Model& model, const std::vector<ColliderPose>& poses,
+                                                    const std::vector<SurfaceMesh>& fixed,
+                                                    std::vector<SurfaceMesh>& posed) {
+  constexpr float kBodyCells = 300.0f;
+  std::vector<const SurfaceMesh*> meshes;
+  for (const SurfaceMesh& m : fixed) meshes.push_back(&m);
+  posed.assign(meshes.size(), SurfaceMesh{});
+  for (size_t k = 0; k < model.colliders.size() && k < meshes.size() && k < poses.size(); ++k) {
+    const Collider& c = model.colliders[k];
+    if (c.shape == ColliderShape::MeshSequence && poses[k].mesh) {
+      posed[k] = sequenceSurface(*poses[k].mesh, poses[k]);
+    } else if (c.shape == ColliderShape::Body) {
+      const Bounds box = colliderBounds(c, poses[k]);
+      if (box.empty()) continue;
+      posed[k] = colliderSurfaceMesh(c, poses[k], box.lo, box.hi, (box.hi - box.lo).maxCoeff() / kBodyCells);
+    } else {
+      continue;
+    }
+    meshes[k] = &posed[k];
+  }
+  return meshes;
+}
+
 // renders one frame into OUT/frame_NNNN.png; throws soak::Error on failure
 std::string renderFrame(const FrameJob& job, int frame) {
   const RunOutput& run = *job.run;
@@ -99,22 +125,8 @@ std::string renderFrame(const FrameJob& job, int frame) {
   PovFrameInput in;
   in.model = &model;
   in.poses = posesAt(model, run.timeOf(frame));
-  for (const SurfaceMesh& m : job.colliderMeshes) in.colliderMesh.push_back(&m);
-  // a Body's skin moves with its parts: meshed at this frame's pose, kBodyCells cells along its longest side
-  constexpr float kBodyCells = 300.0f;
-  std::vector<SurfaceMesh> skins(model.colliders.size());
-  for (size_t k = 0; k < model.colliders.size() && k < in.colliderMesh.size(); ++k) {
-    const Collider& c = model.colliders[k];
-    if (c.shape == ColliderShape::MeshSequence && in.poses[k].mesh) {
-      skins[k] = sequenceSurface(*in.poses[k].mesh, in.poses[k]);
-      in.colliderMesh[k] = &skins[k];
-    }
-    if (c.shape != ColliderShape::Body) continue;
-    const Bounds box = colliderBounds(c, in.poses[k]);
-    if (box.empty()) continue;
-    skins[k] = colliderSurfaceMesh(c, in.poses[k], box.lo, box.hi, (box.hi - box.lo).maxCoeff() / kBodyCells);
-    in.colliderMesh[k] = &skins[k];
-  }
+  std::vector<SurfaceMesh> posed;
+  in.colliderMesh = frameColliderMeshes(model, in.poses, job.colliderMeshes, posed);
   in.cloth = &cloth;
   in.clothColor = clothColors(cloth, job.ramp, cloth.saturationMax > 0.0f ? cloth.saturationMax
                                                                           : model.wetting.saturationMax);

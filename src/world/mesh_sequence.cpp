@@ -26,24 +26,38 @@ using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
 Kernel::Point_3 point(const Vec3d& x) { return {x.x(), x.y(), x.z()}; }
 
-// frame f's topology against frame 0's; throws naming its file
-void checkSameTopology(const TriangleMesh& first, const TriangleMesh& frame, const std::string& name, size_t f) {
+// frame f's topology against the sequence's (frame 0's as its file had it); throws naming its file
+void checkSameTopology(const MeshSequence& s, const TriangleMesh& frame, const std::string& name, size_t f) {
   const std::string where = fmt::format("mesh sequence, frame {}", f);
-  if (frame.vertices.size() != first.vertices.size())
+  if (frame.vertices.size() != size_t(s.vertexCount))
     throw errorAt(name, where,
                   fmt::format("expected {} vertices as in the first frame, got {} (every frame must have the same "
                               "topology: export the animation without changing the mesh)",
-                              first.vertices.size(), frame.vertices.size()));
-  if (frame.triangles.size() != first.triangles.size())
+                              s.vertexCount, frame.vertices.size()));
+  if (frame.triangles.size() != s.triangles.size())
     throw errorAt(name, where,
-                  fmt::format("expected {} triangles as in the first frame, got {}", first.triangles.size(),
+                  fmt::format("expected {} triangles as in the first frame, got {}", s.triangles.size(),
                               frame.triangles.size()));
-  for (size_t t = 0; t < frame.triangles.size(); ++t)
-    if (frame.triangles[t] != first.triangles[t])
+  for (size_t t = 0; t < frame.triangles.size(); ++t) {
+    std::array<int, 3> first = s.triangles[t];
+    if (s.flipped) std::swap(first[1], first[2]);
+    if (frame.triangles[t] != first)
       throw errorAt(name, fmt::format("{}, triangle {}", where, t),
-                    fmt::format("expected vertices ({}, {}, {}) as in the first frame, got ({}, {}, {})",
-                                first.triangles[t][0] + 1, first.triangles[t][1] + 1, first.triangles[t][2] + 1,
-                                frame.triangles[t][0] + 1, frame.triangles[t][1] + 1, frame.triangles[t][2] + 1));
+                    fmt::format("expected vertices ({}, {}, {}) as in the first frame, got ({}, {}, {})", first[0] + 1,
+                                first[1] + 1, first[2] + 1, frame.triangles[t][0] + 1, frame.triangles[t][1] + 1,
+                                frame.triangles[t][2] + 1));
+  }
+}
+
+// frame f's positions appended, after checking its topology and its numbers
+void appendFrame(MeshSequence& s, const TriangleMesh& frame, const std::string& name, size_t f) {
+  if (f > 0) checkSameTopology(s, frame, name, f);
+  for (size_t v = 0; v < frame.vertices.size(); ++v) {
+    if (!frame.vertices[v].allFinite())
+      throw errorAt(name, fmt::format("mesh sequence, frame {}, vertex {}", f, v + 1), "position is not finite");
+    s.positions.push_back(frame.vertices[v]);
+  }
+  ++s.frameCount;
 }
 
 float medianEdgeLength(const MeshSequence& s) {
@@ -68,48 +82,53 @@ Vec3d barycentric(const Vec3d& q, const Vec3d& a, const Vec3d& b, const Vec3d& c
 
 }  // namespace
 
-MeshSequence makeMeshSequence(const std::vector<TriangleMesh>& frames, const std::vector<std::string>& names,
-                              double fps, double start) {
-  const auto nameOf = [&](size_t f) { return f < names.size() ? names[f] : fmt::format("frame {}", f); };
-  if (frames.empty()) throw errorAt(nameOf(0), "mesh sequence", "expected at least one frame");
+namespace {
+
+// a sequence of frame 0 alone: its triangles checked (closed, oriented, none degenerate) and turned
+// outward, its search data; the later frames are appended
+MeshSequence startSequence(const TriangleMesh& frame, const std::string& name, double fps, double start) {
   if (!(fps > 0.0) || !std::isfinite(fps))
-    throw errorAt(nameOf(0), "mesh sequence", fmt::format("expected fps > 0, got {}", fps));
+    throw errorAt(name, "mesh sequence", fmt::format("expected fps > 0, got {}", fps));
   MeshSequence s;
   s.fps = fps;
   s.start = start;
-  s.frameCount = static_cast<int>(frames.size());
-  s.vertexCount = static_cast<int>(frames[0].vertices.size());
-  s.triangles = frames[0].triangles;
-  if (s.triangles.empty()) throw errorAt(nameOf(0), "mesh sequence", "the first frame has no triangles");
+  s.vertexCount = static_cast<int>(frame.vertices.size());
+  s.triangles = frame.triangles;
+  if (s.triangles.empty()) throw errorAt(name, "mesh sequence", "the first frame has no triangles");
   for (size_t t = 0; t < s.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k)
       if (s.triangles[t][k] < 0 || s.triangles[t][k] >= s.vertexCount)
-        throw errorAt(nameOf(0), fmt::format("mesh sequence, triangle {}", t),
+        throw errorAt(name, fmt::format("mesh sequence, triangle {}", t),
                       fmt::format("vertex index {} is out of range [1, {}]", s.triangles[t][k] + 1, s.vertexCount));
-  s.positions.reserve(size_t(s.vertexCount) * frames.size());
-  for (size_t f = 0; f < frames.size(); ++f) {
-    if (f > 0) checkSameTopology(frames[0], frames[f], nameOf(f), f);
-    for (size_t v = 0; v < frames[f].vertices.size(); ++v) {
-      if (!frames[f].vertices[v].allFinite())
-        throw errorAt(nameOf(f), fmt::format("mesh sequence, frame {}, vertex {}", f, v + 1), "position is not finite");
-      s.positions.push_back(frames[f].vertices[v]);
-    }
-  }
-  s.twin = twinTriangles(s.triangles, nameOf(0));
+  appendFrame(s, frame, name, 0);
+  s.twin = twinTriangles(s.triangles, name);
   // outward by frame 0; a closed mesh keeps its orientation through a motion that does not turn it inside out
   std::vector<Vec3d> x0(size_t(s.vertexCount));
   for (size_t v = 0; v < x0.size(); ++v) x0[v] = s.positions[v].cast<double>();
-  if (signedVolume(x0, s.triangles) < 0.0)
+  s.flipped = signedVolume(x0, s.triangles) < 0.0;
+  if (s.flipped)
     for (auto& t : s.triangles) std::swap(t[1], t[2]);
   FeatureNormals n0;
   featureNormals(x0, s.triangles, s.twin, n0);
   for (size_t t = 0; t < s.triangles.size(); ++t)
     if (!(n0.face[t].squaredNorm() > 0.0))
-      throw errorAt(nameOf(0), fmt::format("mesh sequence, frame 0, triangle {}", t), "degenerate triangle (zero area)");
+      throw errorAt(name, fmt::format("mesh sequence, frame 0, triangle {}", t), "degenerate triangle (zero area)");
   s.thickness = medianEdgeLength(s);
   s.vertexTriangle.assign(size_t(s.vertexCount), -1);
   for (size_t t = 0; t < s.triangles.size(); ++t)
     for (int v : s.triangles[t]) s.vertexTriangle[size_t(v)] = static_cast<int>(t);
+  return s;
+}
+
+}  // namespace
+
+MeshSequence makeMeshSequence(const std::vector<TriangleMesh>& frames, const std::vector<std::string>& names,
+                              double fps, double start) {
+  const auto nameOf = [&](size_t f) { return f < names.size() ? names[f] : fmt::format("frame {}", f); };
+  if (frames.empty()) throw errorAt(nameOf(0), "mesh sequence", "expected at least one frame");
+  MeshSequence s = startSequence(frames[0], nameOf(0), fps, start);
+  s.positions.reserve(size_t(s.vertexCount) * frames.size());
+  for (size_t f = 1; f < frames.size(); ++f) appendFrame(s, frames[f], nameOf(f), f);
   return s;
 }
 
@@ -188,20 +207,21 @@ MeshSequence loadMeshSequence(const std::vector<std::string>& files, double fps,
   if (files.empty()) throw errorAt("", "mesh sequence", "expected at least one frame file");
   if (!(scale > 0.0f) || !std::isfinite(scale))
     throw errorAt(files[0], "mesh sequence", fmt::format("expected a scale > 0, got {}", scale));
-  std::vector<TriangleMesh> frames;
-  frames.reserve(files.size());
-  for (size_t f = 0; f < files.size(); ++f) {
-    frames.push_back(loadObjMesh(files[f]));
-    if (f == 0 && int64_t(frames[0].vertices.size()) * int64_t(files.size()) > kMaxSequencePositions)
-      throw errorAt(files[0], "mesh sequence",
-                    fmt::format("{} frames of {} vertices are more than {} positions; use fewer frames or a coarser "
-                                "mesh",
-                                files.size(), frames[0].vertices.size(), kMaxSequencePositions));
-    for (Vec3& x : frames.back().vertices) x *= scale;
-    // the positions are copied into the sequence: check each frame as it comes, keep memory to two copies
-    if (f > 0) checkSameTopology(frames[0], frames[f], files[f], f);
-  }
-  return makeMeshSequence(frames, files, fps, start);
+  // one frame in memory at a time, checked as it is read
+  const auto read = [&](size_t f) {
+    TriangleMesh m = loadObjMesh(files[f]);
+    for (Vec3& x : m.vertices) x *= scale;
+    return m;
+  };
+  const TriangleMesh first = read(0);
+  if (int64_t(first.vertices.size()) * int64_t(files.size()) > kMaxSequencePositions)
+    throw errorAt(files[0], "mesh sequence",
+                  fmt::format("{} frames of {} vertices are more than {} positions; use fewer frames or a coarser mesh",
+                              files.size(), first.vertices.size(), kMaxSequencePositions));
+  MeshSequence s = startSequence(first, files[0], fps, start);
+  s.positions.reserve(first.vertices.size() * files.size());
+  for (size_t f = 1; f < files.size(); ++f) appendFrame(s, read(f), files[f], f);
+  return s;
 }
 
 struct MeshSnapshot::Tree {

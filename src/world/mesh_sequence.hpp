@@ -28,6 +28,7 @@ struct MeshSequence {
   // particle's path is sampled for a crossing, collider_contact.cpp)
   float thickness = 0.0f;
   std::vector<int> vertexTriangle;  // a triangle holding each vertex (-1: none), for search hints
+  bool flipped = false;             // the files' triangles were wound inwards: stored turned (a, c, b)
 };
 
 // most positions (vertices x frames) a sequence may hold: 2^26, 768 MiB of floats
@@ -47,8 +48,8 @@ MeshSequence makeMeshSequence(const std::vector<TriangleMesh>& frames, const std
 // missing file
 std::vector<std::string> meshSequenceFiles(const std::string& pattern, int first, int last, int* firstFound);
 
-// reads the files (positions multiplied by `scale`) into a sequence; refuses a sequence of more than
-// kMaxSequencePositions positions after reading frame 0, before the rest is read
+// reads the files (positions multiplied by `scale`) into a sequence, one at a time, each checked as it
+// is read; refuses a sequence of more than kMaxSequencePositions positions after reading frame 0
 MeshSequence loadMeshSequence(const std::vector<std::string>& files, double fps, double start, float scale);
 
 // the sequence at time t: frames f and f + 1 around u = (t - start) fps blended by u - f, the

@@ -158,7 +158,7 @@ TEST(MeshSequence, InwardWindingIsTurnedAndACollapsedTriangleIsSkipped) {
   TriangleMesh inward = cubeMesh(0.1f);
   for (auto& t : inward.triangles) std::swap(t[1], t[2]);
   TriangleMesh squashed = icosphere(0.3f, 1);
-  const Collider c = sequenceCollider({inward}, 24.0);
+  const Collider c = sequenceCollider({inward, moved(inward, Vec3(0.1f, 0, 0))}, 24.0);  // later frames as wound
   EXPECT_NEAR(colliderDistance(c, colliderPose(c, 0.0), Vec3(0, 0.3f, 0), nullptr), 0.2f, 1e-6f);
   EXPECT_NEAR(colliderDistance(c, colliderPose(c, 0.0), Vec3::Zero(), nullptr), -0.1f, 1e-6f);
   // frame 1 moves one vertex of the sphere onto its neighbour, collapsing the two triangles between them
