@@ -67,6 +67,7 @@ struct WrinkleParams {
 struct SeamParams {
   float closeTime = 0.5f;            // s: each seam's rest length shrinks linearly from its starting gap to 0
   bool gravityWhileClosing = false;  // false: the piece feels no gravity before closeTime, as garment tools sew
+  float settleTime = 0.25f;          // s after closeTime: the piece drapes without friction on the colliders
 };
 
 // the preconditioner of the conjugate gradient of Eq. 5 (garment/block_cg.hpp)

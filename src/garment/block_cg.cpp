@@ -48,26 +48,40 @@ double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::v
 
 namespace {
 
-// the block-Jacobi preconditioner: the inverse of each diagonal block (the first of its row)
-void invertDiagonal(const BlockMatrix& A, CgScratch& w) {
+// the constraint filter of a solve: each row's kind and the contact rows' normals (filterRow)
+struct Filter {
+  const std::vector<uint8_t>& kind;
+  std::span<const Vec3d> normal;
+  Vec3d operator()(size_t i, const Vec3d& a) const { return filterRow(kind[i], normal, i, a); }
+};
+
+// the block-Jacobi preconditioner: the inverse of each diagonal block (the first of its row); of a
+// contact row, the inverse of S A_ii S on the tangent plane (S A_ii S + n n^T a, filtered after, is
+// exactly that, for any a > 0)
+void invertDiagonal(const BlockMatrix& A, const Filter& filter, CgScratch& w) {
   w.precond.resize(static_cast<size_t>(A.rows));
   parallelFor(A.rows, [&](int64_t i) {
     bool ok = false;
-    Eigen::Matrix3d inv;
+    Eigen::Matrix3d inv, block = A.block[A.rowStart[i]];
+    if (filter.kind[i] == kContactRow) {
+      const Vec3d& n = filter.normal[i];
+      const Eigen::Matrix3d s = Eigen::Matrix3d::Identity() - n * n.transpose();
+      block = s * block * s + (block.trace() / 3.0) * n * n.transpose();
+    }
     double det = 0.0;
-    A.block[A.rowStart[i]].computeInverseAndDetWithCheck(inv, det, ok, 1e-300);
+    block.computeInverseAndDetWithCheck(inv, det, ok, 1e-300);
     w.precond[i] = ok ? inv : Eigen::Matrix3d::Identity();
   });
 }
 
 // s = filter(P^-1 r); returns r^T s, summed in row order
-double precondition(const std::vector<Vec3d>& r, const std::vector<uint8_t>& constrained, bool cholesky, CgScratch& w,
+double precondition(const std::vector<Vec3d>& r, const Filter& filter, bool cholesky, CgScratch& w,
                     std::vector<Vec3d>& s) {
   const int64_t n = static_cast<int64_t>(r.size());
   s.resize(r.size());
-  if (cholesky) w.cholesky.solve(r, constrained, s);
+  if (cholesky) w.cholesky.solve(r, s);
   rowsFor(n, [&](int64_t i) {
-    if (!cholesky) s[i] = constrained[i] ? Vec3d::Zero() : Vec3d(w.precond[i] * r[i]);
+    s[i] = filter(i, cholesky ? s[i] : Vec3d(w.precond[i] * r[i]));
     w.partial[i] = r[i].dot(s[i]);
   });
   return orderedSum(w.partial);
@@ -76,39 +90,39 @@ double precondition(const std::vector<Vec3d>& r, const std::vector<uint8_t>& con
 // the solve's start: the preconditioner (Cholesky, or block Jacobi if asked for or if the factor
 // fails), delta0 = filter(b)^T P^-1 filter(b), the scale the residual is measured against,
 // r = filter(b - A x), c = filter(P^-1 r) and deltaNew = r^T c; returns whether Cholesky is used
-bool startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
-              const std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w, CgResult& result, double& delta0,
+bool startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const Filter& filter, const std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w, CgResult& result, double& delta0,
               double& deltaNew) {
   const int64_t n = A.rows;
   w.r.resize(static_cast<size_t>(n));
   w.q.resize(static_cast<size_t>(n));
   w.partial.resize(static_cast<size_t>(n));
   bool cholesky = options.preconditioner == CgPreconditioner::Cholesky;
-  if (cholesky && !w.cholesky.factor(A, constrained)) {
+  if (cholesky && !w.cholesky.factor(A, filter.kind)) {
     result.factorFailed = true;
     cholesky = false;
   }
-  if (!cholesky) invertDiagonal(A, w);
-  rowsFor(n, [&](int64_t i) { w.r[i] = constrained[i] ? Vec3d::Zero() : b[i]; });
-  delta0 = precondition(w.r, constrained, cholesky, w, w.s);
+  if (!cholesky) invertDiagonal(A, filter, w);
+  rowsFor(n, [&](int64_t i) { w.r[i] = filter(i, b[i]); });
+  delta0 = precondition(w.r, filter, cholesky, w, w.s);
   rowsFor(n, [&](int64_t i) {  // r = filter(b - A x)
-    if (constrained[i]) return;
     Vec3d ax = Vec3d::Zero();
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) ax += A.block[k] * x[A.col[k]];
-    w.r[i] = b[i] - ax;
+    w.r[i] = filter(i, b[i] - ax);
   });
-  deltaNew = precondition(w.r, constrained, cholesky, w, w.c);
+  deltaNew = precondition(w.r, filter, cholesky, w, w.c);
   return cholesky;
 }
 
 }  // namespace
 
 CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
-                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w) {
+                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w,
+                     std::span<const Vec3d> contactNormal) {
   const int64_t n = A.rows;
   CgResult result;
   double delta0 = 0.0, deltaNew = 0.0;
-  const bool cholesky = startPcg(A, b, constrained, x, options, w, result, delta0, deltaNew);
+  const Filter filter{constrained, contactNormal};
+  const bool cholesky = startPcg(A, b, filter, x, options, w, result, delta0, deltaNew);
   if (!(delta0 > 0.0)) delta0 = deltaNew;
   if (!(delta0 > 0.0)) {
     // nothing to solve (b and r are zero), or r^T P^-1 r < 0: the matrix is not positive definite
@@ -120,15 +134,15 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
   while (deltaNew > tol2 * delta0 && result.iterations < options.maxIterations) {
     // q = filter(A c)
     rowsFor(n, [&](int64_t i) {
-      if (constrained[i]) {
+      if (rowHeld(constrained[i])) {
         w.q[i].setZero();
         w.partial[i] = 0.0;
         return;
       }
       Vec3d sum = Vec3d::Zero();
       for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) sum += A.block[k] * w.c[A.col[k]];
-      w.q[i] = sum;
-      w.partial[i] = w.c[i].dot(sum);
+      w.q[i] = filter(i, sum);
+      w.partial[i] = w.c[i].dot(w.q[i]);
     });
     const double cq = orderedSum(w.partial);
     if (!(cq > 0.0)) {
@@ -142,7 +156,7 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
       w.r[i] -= alpha * w.q[i];
     });
     const double deltaOld = deltaNew;
-    deltaNew = precondition(w.r, constrained, cholesky, w, w.s);
+    deltaNew = precondition(w.r, filter, cholesky, w, w.s);
     const double beta = deltaNew / deltaOld;
     rowsFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
     ++result.iterations;

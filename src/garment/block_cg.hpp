@@ -1,7 +1,8 @@
 // sparse symmetric matrices of 3x3 blocks (one row per cloth vertex) and the modified
 // preconditioned conjugate gradient of Baraff & Witkin 1998 (section 5.3) that Chen et al. 2012
 // use for Eq. 3-5: constrained vertices are filtered out of every search direction, so the solve
-// never moves them away from their prescribed value. Preconditioned by the exact sparse Cholesky
+// never moves them away from their prescribed value; a contact row is filtered along its normal only
+// (S_i = I - n n^T), so it keeps its prescribed normal velocity change and slides freely. Preconditioned by the exact sparse Cholesky
 // factor of the filtered matrix (sparse_cholesky.hpp) or by block Jacobi. Double precision; every
 // sum runs in a fixed order, so the result does not depend on the thread count.
 #pragma once
@@ -37,11 +38,13 @@ struct CgScratch {
   std::vector<double> partial;           // per-chunk partial sums of the dot products
 };
 
-// solves A x = b for the free rows, with x held at its input value on rows where constrained != 0
-// (Baraff-Witkin's z; the free rows of x are the initial guess). A must be symmetric positive
-// definite on the free rows.
+// solves S (A x - b) = 0 with (I - S) x held at its input value (Baraff-Witkin's z; the free part
+// of x is the initial guess); S_i from constrained[i] (filterRow), contactNormal[i] the unit normal
+// of each kContactRow row (may be empty when there is none). A must be symmetric positive definite
+// on the free part.
 CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
-                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& scratch);
+                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& scratch,
+                     std::span<const Vec3d> contactNormal = {});
 
 // deterministic dot product of two block vectors (fixed chunks, partial sums added in order)
 double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::vector<double>& partial);

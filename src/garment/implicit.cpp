@@ -33,6 +33,7 @@ void checkGarmentParams(const GarmentParams& p, const std::string& where) {
           p.laws.strainLimit);
   require(p.laws.seamStiffness > 0.0f, where, "seams.stiffness", "a number > 0 (N/m)", p.laws.seamStiffness);
   require(p.seams.closeTime >= 0.0f, where, "seams.closeTime", "a number >= 0 (s)", p.seams.closeTime);
+  require(p.seams.settleTime >= 0.0f, where, "seams.settleTime", "a number >= 0 (s)", p.seams.settleTime);
   require(p.build.bendStraightness >= 0.0f && p.build.bendStraightness <= 1.0f, where, "bendStraightness",
           "a number in [0, 1]", p.build.bendStraightness);
   require(p.saturation.delta >= 0.0f, where, "saturation.delta", "a number >= 0", p.saturation.delta);
@@ -189,6 +190,66 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
   });
 }
 
+// contact as a constraint of the solve (Baraff & Witkin 1998 section 5.3; Chen 2012 leave contact to
+// after the solve: departure 16 in docs/models.md): a free vertex within kContactBand margins of a
+// collider at the start of the step, which its own row's estimate v0 + A_ii^-1 b_i would take nearer
+// than the margin, gets a contact row (kContactRow): its velocity along the nearest collider's normal
+// after the step is prescribed, so that it comes down to the margin and never leaves the surface
+// faster than the surface moves; it slides freely, and friction acts after the solve with the row's
+// impulse (integrateWithContact). A vertex whose estimate leaves is not held: no glue. The solve's
+// neighbours of a held vertex see it held, where a push after the solve would stretch their springs.
+constexpr float kContactBand = 1.25f;
+
+void contactRows(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, const Particles& p,
+                 float h, ImplicitScratch& w, ImplicitStats& stats) {
+  const size_t first = static_cast<size_t>(g.firstParticle);
+  const size_t numColliders = std::min(model.colliders.size(), poses.size());
+  const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
+  const float band = kContactBand * margin;
+  w.contactNormal.resize(static_cast<size_t>(g.count));
+  w.contactVelocity.resize(static_cast<size_t>(g.count));
+  w.contactCollider.assign(static_cast<size_t>(g.count), -1);
+  parallelFor(numColliders ? g.count : 0, [&](int64_t v) {
+    if (w.constrained[v] != kFreeRow) return;
+    const Vec3& x0 = p.x[first + static_cast<size_t>(v)];
+    float nearest = band;
+    Vec3 nrm = Vec3::Zero(), vCol = Vec3::Zero();
+    for (size_t c = 0; c < numColliders; ++c) {
+      Vec3 y = x0, n, vc;
+      if (!pushOutOf(model.colliders[c], poses[c], band, y, &n, &vc)) continue;
+      const float d = band - (y - x0).dot(n);  // x0's distance to the surface
+      if (d >= nearest && w.contactCollider[v] >= 0) continue;
+      nearest = d;
+      nrm = n;
+      vCol = vc;
+      w.contactCollider[v] = static_cast<int>(c);
+    }
+    if (w.contactCollider[v] < 0) return;
+    // down to the margin, never faster out than the surface moves: a vertex found inside is put back by
+    // position after the solve (pushOutOf), so the row's impulse is the support alone and friction with it
+    const double vn = std::min((margin - nearest) / h, std::max(vCol.dot(nrm), 0.0f));
+    const Vec3d n = nrm.cast<double>();
+    const Vec3d v0 = p.v[first + static_cast<size_t>(v)].cast<double>();
+    const Vec3d estimate = v0 + w.A.block[g.rowStart[v]].ldlt().solve(w.rhs[v]);
+    if (estimate.dot(n) >= vn) {  // its own forces keep it off the margin
+      w.contactCollider[v] = -1;
+      return;
+    }
+    w.constrained[v] = kContactRow;
+    w.contactNormal[v] = n;
+    w.contactVelocity[v] = vCol;
+    w.dv[v] = (vn - v0.dot(n)) * n;  // the prescribed normal part; the tangential part starts at 0
+  });
+  for (int v = 0; v < g.count; ++v) stats.contactRows += w.constrained[v] == kContactRow ? 1 : 0;
+}
+
+// (A dv - b) of row v: the impulse the row's constraint applies (zero on a free row)
+Vec3d rowResidual(const BlockMatrix& A, const std::vector<Vec3d>& dv, const std::vector<Vec3d>& b, int v) {
+  Vec3d sum = -b[v];
+  for (int k = A.rowStart[v]; k < A.rowStart[v + 1]; ++k) sum += A.block[k] * dv[A.col[k]];
+  return sum;
+}
+
 // a vertex at x touching collider c (its surface moving at vCol) along its outward normal nrm: the
 // velocity into the collider is removed and Coulomb friction (the fabric's mixed with the
 // collider's) acts on the slip, with the removed normal velocity as its impulse; x gives back the
@@ -203,11 +264,43 @@ void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm
   vel = vCol + after;
 }
 
+// the filtered PCG of Eq. 5 with the contact rows; a contact row whose constraint pulled the vertex
+// into the collider (a negative impulse: its neighbours lift it off) is released and the system
+// solved again from the last solution (Baraff & Witkin 1998 release a constraint by its force's
+// sign), at most kReleaseRounds times
+constexpr int kReleaseRounds = 2;
+
+void solveWithContact(const GarmentParams& params, ImplicitScratch& w, ImplicitStats& stats) {
+  CgOptions opt;
+  opt.tolerance = params.cgTolerance;
+  opt.maxIterations = params.cgMaxIterations;
+  opt.preconditioner = params.cgPreconditioner;
+  for (int round = 0;; ++round) {
+    const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg, w.contactNormal);
+    stats.cgIterations += cg.iterations;
+    stats.cgResidual = cg.residual;
+    stats.converged = cg.converged;
+    stats.breakdown = stats.breakdown || cg.breakdown;
+    stats.factorFailed = stats.factorFailed || cg.factorFailed;
+    if (round == kReleaseRounds) return;
+    int released = 0;
+    for (int v = 0; v < w.A.rows; ++v) {
+      if (w.constrained[v] != kContactRow || w.contactNormal[v].dot(rowResidual(w.A, w.dv, w.rhs, v)) >= 0.0) continue;
+      w.constrained[v] = kFreeRow;
+      w.contactCollider[v] = -1;
+      ++released;
+    }
+    stats.contactRows -= released;
+    if (released == 0) return;
+  }
+}
+
 // v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then contact with the colliders at time + h, with
-// the fabric's wet friction; marks the vertices in contact with 3 in w.constrained
+// the fabric's wet friction (none if `frictionless`: a sewn garment settling); marks the vertices in
+// contact with 3 in w.constrained
 void integrateWithContact(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
-                          const std::vector<ColliderPose>& poses, std::span<const float> saturation, Particles& p,
-                          ImplicitScratch& w) {
+                          bool frictionless, const std::vector<ColliderPose>& poses, std::span<const float> saturation,
+                          Particles& p, ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
@@ -225,13 +318,24 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
       p.xPred[i] = x;
       return;
     }
-    const float muFabric = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
-    bool contact = false;
+    const float muFabric =
+        frictionless ? 0.0f : wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
+    const int held = w.constrained[v] == kContactRow ? w.contactCollider[v] : -1;
+    if (held >= 0) {  // friction with the impulse the contact row applied (its normal velocity is the solve's)
+      const Vec3 n = w.contactNormal[v].cast<float>();
+      const float impulse = static_cast<float>(w.contactNormal[v].dot(rowResidual(w.A, w.dv, w.rhs, static_cast<int>(v))));
+      const Vec3 rel = vel - w.contactVelocity[v];
+      const Vec3 after = coulombFriction(rel, n, mixFriction(muFabric, model.colliders[held].friction),
+                                         impulse / p.mass[i]);
+      x += h * (after - rel);
+      vel = w.contactVelocity[v] + after;
+    }
+    bool contact = held >= 0;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm, vCol;
       if (!pushOutOf(model.colliders[c], poses[c], margin, x, &nrm, &vCol)) continue;  // project out to the margin
       contact = true;
-      contactResponse(model.colliders[c], vCol, nrm, muFabric, h, x, vel);
+      contactResponse(model.colliders[c], vCol, nrm, static_cast<int>(c) == held ? 0.0f : muFabric, h, x, vel);
     }
     p.xPred[i] = x;
     p.v[i] = vel;
@@ -321,21 +425,17 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
                            const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
   ImplicitStats stats;
   const double hd = h;
-  const bool sewing = g.springs.kindStart[4] > g.springs.kindStart[3] && time < params.seams.closeTime;
+  const bool sewn = g.springs.kindStart[4] > g.springs.kindStart[3];
+  const bool sewing = sewn && time < params.seams.closeTime;
+  // the panels slide into place without friction until settleTime after the seams close: the contact
+  // rows' Coulomb friction would hold the seams' last millimetres open (departure 16, docs/models.md)
+  const bool frictionless = sewn && time < params.seams.closeTime + params.seams.settleTime;
   springForces(g, params, seamOpenFraction(params.seams, time), p, w, stats);
   constrainRows(model, g, constraints, p, hd, w, stats);
   assembleSystem(model, g, params, p, hd, sewing && !params.seams.gravityWhileClosing ? 0.0 : 1.0, w);
-  CgOptions opt;
-  opt.tolerance = params.cgTolerance;
-  opt.maxIterations = params.cgMaxIterations;
-  opt.preconditioner = params.cgPreconditioner;
-  const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg);
-  stats.cgIterations = cg.iterations;
-  stats.cgResidual = cg.residual;
-  stats.converged = cg.converged;
-  stats.breakdown = cg.breakdown;
-  stats.factorFailed = cg.factorFailed;
-  integrateWithContact(model, g, params, h, poses, saturation, p, w);
+  contactRows(model, g, poses, p, h, w, stats);
+  solveWithContact(params, w, stats);
+  integrateWithContact(model, g, params, h, frictionless, poses, saturation, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision)
     stats.selfContacts = selfCollisionStep(model, g, poses, p, w);

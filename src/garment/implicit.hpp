@@ -3,8 +3,9 @@
 //   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),   v1 = v0 + dv,   x1 = x0 + h v1,
 // with the KES springs of springs.hpp, gravity, Rayleigh damping D = alpha M + beta K (Eq. 22-24),
 // the saturation mass of Eq. 15-19 (read from Particles::mass), pinned vertices and temporary
-// position constraints (wrinkles.hpp) enforced by the filtered PCG of block_cg.hpp, and, after the
-// solve, collider contact with the wet friction of Fig. 5 (wet_friction.hpp).
+// position constraints (wrinkles.hpp) and the contact of vertices resting on a collider enforced by the
+// filtered PCG of block_cg.hpp, and, after the solve, friction with the wet friction curve of Fig. 5
+// (wet_friction.hpp) and contact of the vertices that reached a collider during the step.
 //
 // Use from the step, for a piece whose scene says "solver": "implicit" (docs/garment.md): one call
 //   ImplicitStats s = garmentSubstep(model, g, params, saturation, h, time, stepIndex, poses, p, scratch);
@@ -61,7 +62,10 @@ struct ImplicitScratch {
   std::vector<Eigen::Matrix3d> springStiffness;
   std::vector<float> strain;
   std::vector<Vec3d> rhs, dv;
-  std::vector<uint8_t> constrained;
+  std::vector<uint8_t> constrained;     // per vertex: 0 free, 1 pinned, 2 disturbed, kContactRow; 3 after the step: in contact
+  std::vector<Vec3d> contactNormal;     // per contact row: the collider's unit normal
+  std::vector<Vec3> contactVelocity;    // per contact row: the collider's surface velocity (m/s)
+  std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
   std::vector<float> invMass;      // self-collision: 1/m, 0 for pinned and disturbed vertices
@@ -75,7 +79,8 @@ struct ImplicitStats {
   bool breakdown = false;    // the system was not positive definite
   bool factorFailed = false; // the Cholesky preconditioner failed to factor: block Jacobi was used
   int constrainedVertices = 0;  // pinned + disturbed
-  int contacts = 0;             // vertices pushed out of a collider
+  int contacts = 0;             // vertices held on (contact rows) or pushed out of a collider
+  int contactRows = 0;          // vertices held on a collider by the solve (kContactRow)
   int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider
   int selfContacts = 0;         // vertex-triangle pushes of the self-collision (material.selfCollision)
   int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)

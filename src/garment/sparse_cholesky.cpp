@@ -44,7 +44,7 @@ bool SparseCholesky::factor(const BlockMatrix& A, const std::vector<uint8_t>& co
   std::fill(values, values + lower_.nonZeros(), 0.0);
   forLowerEntries(A, [&](int k, int a, int b, int row, int column) {
     const int i = row / 3, j = column / 3;
-    const bool filtered = constrained[i] || constrained[j];
+    const bool filtered = rowHeld(constrained[i]) || rowHeld(constrained[j]);
     if (filtered && i != j) return;  // a constrained vertex is coupled to nothing
     values[valueOf_[9 * k + 3 * a + b]] += filtered ? (a == b ? 1.0 : 0.0) : A.block[k](a, b);
   });
@@ -52,14 +52,11 @@ bool SparseCholesky::factor(const BlockMatrix& A, const std::vector<uint8_t>& co
   return llt_->info() == Eigen::Success;
 }
 
-void SparseCholesky::solve(const std::vector<Vec3d>& r, const std::vector<uint8_t>& constrained,
-                           std::vector<Vec3d>& s) const {
+void SparseCholesky::solve(const std::vector<Vec3d>& r, std::vector<Vec3d>& s) const {
   const Eigen::Index n = static_cast<Eigen::Index>(r.size()) * 3;
   s.resize(r.size());
   if (r.empty()) return;
   Eigen::Map<Eigen::VectorXd>(s[0].data(), n) = llt_->solve(Eigen::Map<const Eigen::VectorXd>(r[0].data(), n));
-  for (size_t i = 0; i < r.size(); ++i)
-    if (constrained[i]) s[i].setZero();
 }
 
 }  // namespace soak

@@ -1,5 +1,6 @@
 // the sparse Cholesky preconditioner of the filtered PCG (block_cg.hpp): the filtered system matrix
-// (a constrained vertex's row and column replaced by the identity) factored exactly, L L^T, with
+// (a held vertex's row and column replaced by the identity; a contact row is factored whole and
+// filtered by the solve) factored exactly, L L^T, with
 // Eigen's SimplicialLLT in an AMD order. With it the PCG needs one or two iterations; the fill-reducing
 // order and the elimination tree depend only on the block pattern, so they are computed once per
 // pattern and reused by every later solve.
@@ -22,11 +23,11 @@ class SparseCholesky {
   SparseCholesky& operator=(const SparseCholesky&) { return *this = SparseCholesky(); }
   SparseCholesky(SparseCholesky&&) = default;
   SparseCholesky& operator=(SparseCholesky&&) = default;
-  // factors the filtered matrix of A (constrained rows and columns replaced by the identity);
+  // factors the filtered matrix of A (held rows and columns, rowHeld, replaced by the identity);
   // false when it is not numerically positive definite (the caller falls back to block Jacobi)
   bool factor(const BlockMatrix& A, const std::vector<uint8_t>& constrained);
-  // s = filter(F^-1 r) with F the factored matrix; r, s: one Vec3d per row
-  void solve(const std::vector<Vec3d>& r, const std::vector<uint8_t>& constrained, std::vector<Vec3d>& s) const;
+  // s = F^-1 r with F the factored matrix (the caller filters s); r, s: one Vec3d per row
+  void solve(const std::vector<Vec3d>& r, std::vector<Vec3d>& s) const;
 
  private:
   void buildPattern(const BlockMatrix& A);

@@ -105,6 +105,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.seams.closeTime = seams.number("closeTime", d.seams.closeTime, Range::nonNegative());
   g.laws.seamStiffness = seams.number("stiffness", g.laws.stretch.a1, Range::positive());  // N/m; an edge's
   g.seams.gravityWhileClosing = seams.boolean("gravityWhileClosing", d.seams.gravityWhileClosing);
+  g.seams.settleTime = seams.number("settleTime", d.seams.settleTime, Range::nonNegative());
   seams.finish();
   ObjectReader cg = r.object("cg");
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());

@@ -95,6 +95,69 @@ TEST(GarmentCg, FilteredPcgSolvesFreeRowsAndKeepsConstrainedRows) {
   for (int a = 0; a < 4; ++a) EXPECT_LT((x[freeRows[a]] - ref.segment<3>(3 * a)).norm(), 1e-8);
 }
 
+// a contact row (kContactRow) keeps its velocity change along its normal and is solved in its tangent
+// plane: the result is the dense solve of T^T A T y = T^T (b - A z), x = z + T y, with T spanning the
+// free rows and the contact rows' tangent planes; the impulse A x - b of a contact row is along its
+// normal. With either preconditioner.
+TEST(GarmentCg, AContactRowIsHeldAlongItsNormalOnly) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 6;
+  Eigen::MatrixXd dense = 8.0 * Eigen::MatrixXd::Identity(3 * n, 3 * n);
+  for (int i = 0; i + 1 < n; ++i) {
+    const Eigen::Matrix3d b = randomBlock(rng);
+    dense.block<3, 3>(3 * i, 3 * i + 3) = b;
+    dense.block<3, 3>(3 * i + 3, 3 * i) = b.transpose();
+  }
+  const BlockMatrix A = blocksOf(dense);
+  std::vector<Vec3d> b(n), normal(n, Vec3d::Zero()), z(n, Vec3d::Zero());
+  for (auto& v : b) v = Vec3d(u(rng), u(rng), u(rng));
+  const std::vector<uint8_t> kind{0, 1, kContactRow, 0, kContactRow, 0};
+  z[1] = Vec3d(0.3, -0.2, 0.1);
+  for (int i : {2, 4}) {
+    normal[i] = Vec3d(u(rng), u(rng), u(rng)).normalized();
+    z[i] = (0.5 * i) * normal[i];
+  }
+  // T: 3 columns per free row, 2 (a tangent basis) per contact row
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  int cols = 0;
+  for (int i = 0; i < n; ++i) {
+    if (kind[i] == 0) {
+      T.block<3, 3>(3 * i, cols) = Eigen::Matrix3d::Identity();
+      cols += 3;
+    } else if (kind[i] == kContactRow) {
+      const Vec3d t1 = normal[i].unitOrthogonal(), t2 = normal[i].cross(t1);
+      T.block<3, 1>(3 * i, cols++) = t1;
+      T.block<3, 1>(3 * i, cols++) = t2;
+    }
+  }
+  T.conservativeResize(Eigen::NoChange, cols);
+  Eigen::VectorXd bz(3 * n), zz(3 * n);
+  for (int i = 0; i < n; ++i) {
+    bz.segment<3>(3 * i) = b[i];
+    zz.segment<3>(3 * i) = z[i];
+  }
+  const Eigen::VectorXd ref = zz + T * (T.transpose() * dense * T).ldlt().solve(T.transpose() * (bz - dense * zz));
+  for (CgPreconditioner pre : {CgPreconditioner::BlockJacobi, CgPreconditioner::Cholesky}) {
+    std::vector<Vec3d> x = z;
+    CgScratch scratch;
+    CgOptions opt{1e-12, 200};
+    opt.preconditioner = pre;
+    const CgResult res = filteredPcg(A, b, kind, x, opt, scratch, normal);
+    EXPECT_TRUE(res.converged);
+    EXPECT_EQ(x[1], z[1]);
+    for (int i : {2, 4}) EXPECT_NEAR(x[i].dot(normal[i]), z[i].dot(normal[i]), 1e-12);
+    for (int i = 0; i < n; ++i) EXPECT_LT((x[i] - ref.segment<3>(3 * i)).norm(), 1e-9) << "row " << i;
+    std::vector<Vec3d> ax;
+    A.multiply(x, ax);
+    for (int i : {2, 4}) {
+      const Vec3d impulse = ax[i] - b[i];
+      EXPECT_LT((impulse - impulse.dot(normal[i]) * normal[i]).norm(), 1e-9);
+      EXPECT_GT(std::abs(impulse.dot(normal[i])), 1e-3);  // the row does hold something
+    }
+  }
+}
+
 // y = A x row by row equals the dense product, for a non-symmetric pattern with a gap in it
 TEST(GarmentCg, MultiplyMatchesTheDenseProduct) {
   std::mt19937 rng(11);
