@@ -145,6 +145,42 @@ TEST(GarmentImplicit, PinnedVerticesNeverMove) {
   }
 }
 
+// contact rows (docs/garment.md "Body contact"): a sheet lying on the floor is held there by its rows,
+// whose impulses carry exactly its weight (the solve's support, not a push after it); turned upside
+// down (gravity up) the rows pull, are released, and the sheet leaves the floor: no glue
+TEST(GarmentImplicit, TheFloorCarriesARestingSheetsWeightAndLetsItGo) {
+  const float h = 1.0f / 60.0f;
+  Rig r;
+  Collider floor;
+  floor.shape = ColliderShape::Plane;
+  floor.friction = 0.5f;
+  r.model.colliders.push_back(floor);
+  makeHangingRig(r, 8, 0.3f, 0.0f, {});
+  const float margin = contactMargin(r.model, 1);
+  for (auto& x : r.p.x) x.y() = margin;
+  double weight = 0.0;
+  for (int i = 0; i < r.model.numCloth; ++i) weight += r.p.mass[i] * 9.81;
+  for (int k = 0; k < 30; ++k) {
+    const ImplicitStats s = stepRig(r, k * h, h);
+    EXPECT_EQ(s.contactRows, r.model.numCloth) << "step " << k;
+    std::vector<Vec3d> ax;
+    r.scratch.A.multiply(r.scratch.dv, ax);
+    double support = 0.0;  // N: the rows' impulses over the step
+    for (int i = 0; i < r.model.numCloth; ++i) support += r.scratch.contactNormal[i].dot(ax[i] - r.scratch.rhs[i]) / h;
+    EXPECT_NEAR(support, weight, 1e-3 * weight) << "step " << k;
+    for (int i = 0; i < r.model.numCloth; ++i) {
+      ASSERT_NEAR(r.p.x[i].y(), margin, 1e-6f) << "vertex " << i << " step " << k;
+      ASSERT_LT(r.p.v[i].norm(), 1e-6f);
+    }
+  }
+  r.model.solver.gravity = Vec3(0, 9.81f, 0);
+  ImplicitStats last;
+  for (int k = 30; k < 40; ++k) last = stepRig(r, k * h, h);
+  EXPECT_EQ(last.contactRows, 0);
+  const float t = 10 * h;  // free fall from rest: g t^2 / 2 (backward Euler: g h^2 (1 + ... + 10), 10% more)
+  for (int i = 0; i < r.model.numCloth; ++i) EXPECT_GT(r.p.x[i].y(), margin + 0.5f * 9.81f * t * t);
+}
+
 TEST(GarmentImplicit, RefusesNegativeRayleighAlphaAndBadLaws) {
   GarmentParams p;
   EXPECT_NO_THROW(checkGarmentParams(p, "cloth[0].garment"));

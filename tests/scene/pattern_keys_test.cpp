@@ -43,8 +43,11 @@ TEST(PatternScene, KeysReachTheModel) {
   EXPECT_FLOAT_EQ(piece.garment.laws.seamStiffness, piece.garment.laws.stretch.a1);  // an edge's, by default
   ASSERT_TRUE(piece.implicit);
   EXPECT_EQ(piece.implicit->springs.kindStart[4] - piece.implicit->springs.kindStart[3], 18);
-  const Scene k = fromString(sceneWith(kTube), {"cloth.0.garment.seams.stiffness=500"});
+  EXPECT_FLOAT_EQ(piece.garment.seams.settleTime, 0.25f);
+  const Scene k = fromString(sceneWith(kTube), {"cloth.0.garment.seams.stiffness=500", "cloth.0.garment.seams.settleTime=0"});
   EXPECT_FLOAT_EQ(k.model.pieces[0].garment.laws.seamStiffness, 500.0f);
+  EXPECT_FLOAT_EQ(k.model.pieces[0].garment.seams.settleTime, 0.0f);
+  EXPECT_HAS(loadError(sceneWith(kTube), {"cloth.0.garment.seams.settleTime=-1"}), "settleTime");
 }
 
 // the shipped garments: their seams close, no vertex ends inside the body, and the garment stays on
