@@ -74,6 +74,7 @@ struct SeamParams {
 enum class CgPreconditioner : uint8_t {
   BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap per iteration, hundreds of iterations on stiff cloth
   Cholesky,     // the exact sparse Cholesky factor of the filtered system: one iteration, a costly factor
+  Multigrid,    // one V-cycle of two-level smoothed aggregation (garment/multigrid.hpp)
 };
 
 // everything the implicit garment solver of one cloth piece reads (implicit.hpp)

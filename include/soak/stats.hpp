@@ -42,6 +42,7 @@ struct GarmentStats {
   uint64_t breakdowns = 0;      // solves whose system was not positive definite
   uint64_t factorFailures = 0;  // solves whose Cholesky preconditioner failed to factor (block Jacobi used)
   uint64_t contacts = 0;        // vertex-collider contacts
+  uint64_t contactRows = 0;     // of them, vertices held on a collider by the solve (contact rows)
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)
   uint64_t selfContacts = 0;    // vertex-triangle pushes of an implicit piece's self-collision
   uint64_t disturbances = 0;    // wrinkle constraints applied (section 3.5)
@@ -49,7 +50,7 @@ struct GarmentStats {
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     return *this;
   }
 };

@@ -75,42 +75,47 @@ void invertDiagonal(const BlockMatrix& A, const Filter& filter, CgScratch& w) {
 }
 
 // s = filter(P^-1 r); returns r^T s, summed in row order
-double precondition(const std::vector<Vec3d>& r, const Filter& filter, bool cholesky, CgScratch& w,
+double precondition(const std::vector<Vec3d>& r, const Filter& filter, CgPreconditioner kind, CgScratch& w,
                     std::vector<Vec3d>& s) {
   const int64_t n = static_cast<int64_t>(r.size());
   s.resize(r.size());
-  if (cholesky) w.cholesky.solve(r, s);
+  if (kind == CgPreconditioner::Cholesky) w.cholesky.solve(r, s);
+  if (kind == CgPreconditioner::Multigrid) w.multigrid.apply(r, s);
   rowsFor(n, [&](int64_t i) {
-    s[i] = filter(i, cholesky ? s[i] : Vec3d(w.precond[i] * r[i]));
+    s[i] = filter(i, kind == CgPreconditioner::BlockJacobi ? Vec3d(w.precond[i] * r[i]) : s[i]);
     w.partial[i] = r[i].dot(s[i]);
   });
   return orderedSum(w.partial);
 }
 
-// the solve's start: the preconditioner (Cholesky, or block Jacobi if asked for or if the factor
-// fails), delta0 = filter(b)^T P^-1 filter(b), the scale the residual is measured against,
-// r = filter(b - A x), c = filter(P^-1 r) and deltaNew = r^T c; returns whether Cholesky is used
-bool startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const Filter& filter, const std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w, CgResult& result, double& delta0,
-              double& deltaNew) {
+// the solve's start: the preconditioner (as asked for, or block Jacobi if its factor fails),
+// delta0 = filter(b)^T P^-1 filter(b), the scale the residual is measured against,
+// r = filter(b - A x), c = filter(P^-1 r) and deltaNew = r^T c; returns the preconditioner used
+CgPreconditioner startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const Filter& filter,
+                          const std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w, CgResult& result,
+                          double& delta0, double& deltaNew) {
   const int64_t n = A.rows;
   w.r.resize(static_cast<size_t>(n));
   w.q.resize(static_cast<size_t>(n));
   w.partial.resize(static_cast<size_t>(n));
-  bool cholesky = options.preconditioner == CgPreconditioner::Cholesky;
-  if (cholesky && !w.cholesky.factor(A, filter.kind)) {
+  CgPreconditioner kind = options.preconditioner;
+  const bool factored = kind == CgPreconditioner::Cholesky    ? w.cholesky.factor(A, filter.kind)
+                        : kind == CgPreconditioner::Multigrid ? w.multigrid.setup(A, filter.kind, filter.normal)
+                                                              : true;
+  if (!factored) {
     result.factorFailed = true;
-    cholesky = false;
+    kind = CgPreconditioner::BlockJacobi;
   }
-  if (!cholesky) invertDiagonal(A, filter, w);
+  if (kind == CgPreconditioner::BlockJacobi) invertDiagonal(A, filter, w);
   rowsFor(n, [&](int64_t i) { w.r[i] = filter(i, b[i]); });
-  delta0 = precondition(w.r, filter, cholesky, w, w.s);
+  delta0 = precondition(w.r, filter, kind, w, w.s);
   rowsFor(n, [&](int64_t i) {  // r = filter(b - A x)
     Vec3d ax = Vec3d::Zero();
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) ax += A.block[k] * x[A.col[k]];
     w.r[i] = filter(i, b[i] - ax);
   });
-  deltaNew = precondition(w.r, filter, cholesky, w, w.c);
-  return cholesky;
+  deltaNew = precondition(w.r, filter, kind, w, w.c);
+  return kind;
 }
 
 }  // namespace
@@ -122,7 +127,7 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
   CgResult result;
   double delta0 = 0.0, deltaNew = 0.0;
   const Filter filter{constrained, contactNormal};
-  const bool cholesky = startPcg(A, b, filter, x, options, w, result, delta0, deltaNew);
+  const CgPreconditioner kind = startPcg(A, b, filter, x, options, w, result, delta0, deltaNew);
   if (!(delta0 > 0.0)) delta0 = deltaNew;
   if (!(delta0 > 0.0)) {
     // nothing to solve (b and r are zero), or r^T P^-1 r < 0: the matrix is not positive definite
@@ -156,7 +161,7 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
       w.r[i] -= alpha * w.q[i];
     });
     const double deltaOld = deltaNew;
-    deltaNew = precondition(w.r, filter, cholesky, w, w.s);
+    deltaNew = precondition(w.r, filter, kind, w, w.s);
     const double beta = deltaNew / deltaOld;
     rowsFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
     ++result.iterations;

@@ -2,14 +2,16 @@
 // preconditioned conjugate gradient of Baraff & Witkin 1998 (section 5.3) that Chen et al. 2012
 // use for Eq. 3-5: constrained vertices are filtered out of every search direction, so the solve
 // never moves them away from their prescribed value; a contact row is filtered along its normal only
-// (S_i = I - n n^T), so it keeps its prescribed normal velocity change and slides freely. Preconditioned by the exact sparse Cholesky
-// factor of the filtered matrix (sparse_cholesky.hpp) or by block Jacobi. Double precision; every
+// (S_i = I - n n^T), so it keeps its prescribed normal velocity change and slides freely.
+// Preconditioned by block Jacobi, the exact sparse Cholesky factor of the filtered matrix
+// (sparse_cholesky.hpp) or a two-level multigrid V-cycle (multigrid.hpp). Double precision; every
 // sum runs in a fixed order, so the result does not depend on the thread count.
 #pragma once
 #include <soak/garment_params.hpp>
 #include <soak/math.hpp>
 
 #include "garment/block_matrix.hpp"
+#include "garment/multigrid.hpp"
 #include "garment/sparse_cholesky.hpp"
 
 #include <cstdint>
@@ -28,13 +30,14 @@ struct CgResult {
   double residual = 0.0;   // the relative preconditioned residual at exit
   bool converged = false;
   bool breakdown = false;  // a direction with c^T A c <= 0: the matrix is not positive definite
-  bool factorFailed = false;  // the Cholesky factor failed (not positive definite): block Jacobi was used
+  bool factorFailed = false;  // the Cholesky or coarse multigrid factor failed: block Jacobi was used
 };
 
 struct CgScratch {
   std::vector<Vec3d> r, c, q, s;
   std::vector<Eigen::Matrix3d> precond;  // inverse diagonal blocks (block Jacobi)
   SparseCholesky cholesky;               // the factor and its pattern, kept from solve to solve
+  Multigrid multigrid;                   // the levels of the last solve
   std::vector<double> partial;           // per-chunk partial sums of the dot products
 };
 

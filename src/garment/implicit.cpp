@@ -190,8 +190,8 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
   });
 }
 
-// contact as a constraint of the solve (Baraff & Witkin 1998 section 5.3; Chen 2012 leave contact to
-// after the solve: departure 16 in docs/models.md): a free vertex within kContactBand margins of a
+// contact as a constraint of the solve (Baraff & Witkin 1998 section 5.3; Chen 2012 leaves contact to
+// after the solve: docs/garment.md departure 10): a free vertex within kContactBand margins of a
 // collider at the start of the step, which its own row's estimate v0 + A_ii^-1 b_i would take nearer
 // than the margin, gets a contact row (kContactRow): its velocity along the nearest collider's normal
 // after the step is prescribed, so that it comes down to the margin and never leaves the surface
@@ -428,7 +428,7 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   const bool sewn = g.springs.kindStart[4] > g.springs.kindStart[3];
   const bool sewing = sewn && time < params.seams.closeTime;
   // the panels slide into place without friction until settleTime after the seams close: the contact
-  // rows' Coulomb friction would hold the seams' last millimetres open (departure 16, docs/models.md)
+  // rows' Coulomb friction would hold the seams' last millimetres open (docs/garment.md departure 9)
   const bool frictionless = sewn && time < params.seams.closeTime + params.seams.settleTime;
   springForces(g, params, seamOpenFraction(params.seams, time), p, w, stats);
   constrainRows(model, g, constraints, p, hd, w, stats);

@@ -205,6 +205,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.breakdowns += r.breakdown ? 1 : 0;
     gs.factorFailures += r.factorFailed ? 1 : 0;
     gs.contacts += static_cast<uint64_t>(r.contacts);
+    gs.contactRows += static_cast<uint64_t>(r.contactRows);
     gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
     gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);

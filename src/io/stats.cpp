@@ -87,6 +87,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"breakdowns", g.breakdowns},
                     {"factorFailures", g.factorFailures},
                     {"contacts", g.contacts},
+                    {"contactRows", g.contactRows},
                     {"edgeContacts", g.edgeContacts},
                     {"selfContacts", g.selfContacts},
                     {"disturbances", g.disturbances},

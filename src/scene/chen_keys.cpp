@@ -110,9 +110,8 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   ObjectReader cg = r.object("cg");
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());
   g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));
-  g.cgPreconditioner = cg.choice("preconditioner", {"blockJacobi", "cholesky"}, std::string("blockJacobi")) == 1
-                           ? CgPreconditioner::Cholesky
-                           : CgPreconditioner::BlockJacobi;
+  g.cgPreconditioner = static_cast<CgPreconditioner>(
+      cg.choice("preconditioner", {"blockJacobi", "cholesky", "multigrid"}, std::string("blockJacobi")));
   cg.finish();
   ObjectReader w = r.object("wrinkles");
   g.wrinkles.enabled = w.boolean("enabled", w.present());

@@ -464,6 +464,8 @@ TEST(GarmentRun, GarmentDoesNotPenetrateTheMannequin) {
     worst = std::min(worst, bodyDistance(m.colliders, s.state.time, s.state.particles.x[size_t(i)], nullptr));
   EXPECT_GT(worst, -thickness);
   EXPECT_GT(total.garment.contacts, 0u);  // it does rest on the body
+  EXPECT_GT(total.garment.contactRows, 0u);  // held there by the solve's contact rows
+  EXPECT_LE(total.garment.contactRows, total.garment.contacts);
   // the shirt stays on: its lowest point is still above the hips' height minus a hand
   double lowest = 1e30;
   for (int i = 0; i < m.numCloth; ++i) lowest = std::min(lowest, double(s.state.particles.x[size_t(i)].y()));
