@@ -136,8 +136,7 @@ bool Multigrid::setup(const BlockMatrix& A, const std::vector<uint8_t>& kind, st
   return ldlt_->info() == Eigen::Success;
 }
 
-void Multigrid::smooth(const Eigen::VectorXd& r) {
-  res_ = r - fine_ * x_;
+void Multigrid::jacobiSweep() {
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(diagInv_.size()); ++i)
     x_.segment<3>(3 * i) += omega_ * (diagInv_[i] * res_.segment<3>(3 * i));
 }
@@ -148,11 +147,18 @@ void Multigrid::apply(const std::vector<Vec3d>& r, std::vector<Vec3d>& s) {
   if (r.empty()) return;
   const Eigen::Map<const Eigen::VectorXd> rv(r[0].data(), n);
   x_.setZero(n);
-  for (int k = 0; k < kSmoothingSweeps; ++k) smooth(rv);
+  res_ = rv;  // the first sweep from x = 0 needs no product
+  for (int k = 0; k < kSmoothingSweeps; ++k) {
+    if (k > 0) res_ = rv - fine_ * x_;
+    jacobiSweep();
+  }
   res_ = rv - fine_ * x_;
   tmp_ = restrict_ * res_;
   x_ += prolong_ * ldlt_->solve(tmp_);
-  for (int k = 0; k < kSmoothingSweeps; ++k) smooth(rv);
+  for (int k = 0; k < kSmoothingSweeps; ++k) {
+    res_ = rv - fine_ * x_;
+    jacobiSweep();
+  }
   Eigen::Map<Eigen::VectorXd>(s[0].data(), n) = x_;
 }
 

@@ -33,7 +33,6 @@ class Multigrid {
   // s = one V-cycle applied to r (a symmetric positive definite approximation of the filtered A's
   // inverse on the free part; the caller filters s)
   void apply(const std::vector<Vec3d>& r, std::vector<Vec3d>& s);
-  int coarseSize() const { return static_cast<int>(coarse_.rows()); }
 
  private:
   using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor>;
@@ -47,7 +46,7 @@ class Multigrid {
   std::unique_ptr<Ldlt> ldlt_;            // on the heap: Eigen's solvers cannot be moved
   Eigen::VectorXd x_, res_, tmp_;         // V-cycle work vectors
 
-  void smooth(const Eigen::VectorXd& r);  // x_ += omega D^-1 (r - A x_)
+  void jacobiSweep();  // x_ += omega D^-1 res_ (res_ = r - A x_)
 };
 
 }  // namespace soak
