@@ -55,19 +55,14 @@ struct Filter {
   Vec3d operator()(size_t i, const Vec3d& a) const { return filterRow(kind[i], normal, i, a); }
 };
 
-// the block-Jacobi preconditioner: the inverse of each diagonal block (the first of its row); of a
-// contact row, the inverse of S A_ii S on the tangent plane (S A_ii S + n n^T a, filtered after, is
-// exactly that, for any a > 0)
+// the block-Jacobi preconditioner: the inverse of each diagonal block (the first of its row), of a
+// contact row on its tangent plane (filteredDiagonal)
 void invertDiagonal(const BlockMatrix& A, const Filter& filter, CgScratch& w) {
   w.precond.resize(static_cast<size_t>(A.rows));
   parallelFor(A.rows, [&](int64_t i) {
     bool ok = false;
-    Eigen::Matrix3d inv, block = A.block[A.rowStart[i]];
-    if (filter.kind[i] == kContactRow) {
-      const Vec3d& n = filter.normal[i];
-      const Eigen::Matrix3d s = Eigen::Matrix3d::Identity() - n * n.transpose();
-      block = s * block * s + (block.trace() / 3.0) * n * n.transpose();
-    }
+    Eigen::Matrix3d inv;
+    const Eigen::Matrix3d block = filteredDiagonal(filter.kind[i], filter.normal, i, A.block[A.rowStart[i]]);
     double det = 0.0;
     block.computeInverseAndDetWithCheck(inv, det, ok, 1e-300);
     w.precond[i] = ok ? inv : Eigen::Matrix3d::Identity();

@@ -29,5 +29,19 @@ inline Vec3d filterRow(uint8_t kind, std::span<const Vec3d> normal, size_t i, co
   return Vec3d::Zero();
 }
 inline bool rowHeld(uint8_t kind) { return kind != kFreeRow && kind != kContactRow; }
+// S_i as a matrix: I, I - n n^T or 0
+inline Eigen::Matrix3d filterMatrix(uint8_t kind, std::span<const Vec3d> normal, size_t i) {
+  if (kind == kFreeRow) return Eigen::Matrix3d::Identity();
+  if (kind == kContactRow) return Eigen::Matrix3d::Identity() - normal[i] * normal[i].transpose();
+  return Eigen::Matrix3d::Zero();
+}
+// the diagonal block a of row i as the preconditioners take it: a held row's is the identity; a
+// contact row's S a S + n n^T tr(a) / 3, whose inverse filtered is that of S a S on the tangent plane
+inline Eigen::Matrix3d filteredDiagonal(uint8_t kind, std::span<const Vec3d> normal, size_t i, const Eigen::Matrix3d& a) {
+  if (kind == kFreeRow) return a;
+  if (kind != kContactRow) return Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d s = filterMatrix(kind, normal, i);
+  return s * a * s + (a.trace() / 3.0) * normal[i] * normal[i].transpose();
+}
 
 }  // namespace soak

@@ -11,15 +11,8 @@ namespace {
 constexpr int kSmoothingSweeps = 2;  // damped block-Jacobi sweeps before and after the coarse correction
 constexpr int kPowerIterations = 10;  // for lambda_max(D^-1 A), which sets the damping
 
-// the 3x3 filter of row i as a matrix: I (free), I - n n^T (contact), 0 (held)
-Eigen::Matrix3d filterMatrix(uint8_t kind, std::span<const Vec3d> normal, size_t i) {
-  if (kind == kFreeRow) return Eigen::Matrix3d::Identity();
-  if (kind == kContactRow) return Eigen::Matrix3d::Identity() - normal[i] * normal[i].transpose();
-  return Eigen::Matrix3d::Zero();
-}
-
-// the filtered system as scalar entries: S_i A_ij S_j, a held row's diagonal block the identity, a
-// contact row's S A_ii S + n n^T tr(A_ii) / 3 (nonsingular, the normal decoupled); its diagonal blocks
+// the filtered system as scalar entries: S_i A_ij S_j off the diagonal, filteredDiagonal on it (a
+// held row the identity, a contact row's normal decoupled); its diagonal blocks
 std::vector<Eigen::Triplet<double>> filteredEntries(const BlockMatrix& A, const std::vector<uint8_t>& kind,
                                                     std::span<const Vec3d> normal,
                                                     std::vector<Eigen::Matrix3d>& diagonal) {
@@ -30,12 +23,9 @@ std::vector<Eigen::Triplet<double>> filteredEntries(const BlockMatrix& A, const 
     const Eigen::Matrix3d si = filterMatrix(kind[i], normal, i);
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) {
       const int j = A.col[k];
-      Eigen::Matrix3d b = si * A.block[k] * filterMatrix(kind[j], normal, j);
-      if (j == i) {
-        if (rowHeld(kind[i])) b = Eigen::Matrix3d::Identity();
-        if (kind[i] == kContactRow) b += (A.block[k].trace() / 3.0) * normal[i] * normal[i].transpose();
-        diagonal[i] = b;
-      }
+      const Eigen::Matrix3d b = j == i ? filteredDiagonal(kind[i], normal, i, A.block[k])
+                                       : Eigen::Matrix3d(si * A.block[k] * filterMatrix(kind[j], normal, j));
+      if (j == i) diagonal[i] = b;
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) entries.emplace_back(3 * i + a, 3 * j + c, b(a, c));
     }
