@@ -40,7 +40,7 @@ struct GarmentStats {
   double maxResidual = 0.0;     // largest relative CG residual at exit
   uint64_t unconverged = 0;     // solves whose CG stopped at garment.cg.maxIterations (the step still ran)
   uint64_t breakdowns = 0;      // solves whose system was not positive definite
-  uint64_t factorFailures = 0;  // solves whose Cholesky preconditioner failed to factor (block Jacobi used)
+  uint64_t factorFailures = 0;  // solves whose Cholesky or multigrid factor failed (block Jacobi used)
   uint64_t contacts = 0;        // vertex-collider contacts
   uint64_t contactRows = 0;     // of them, vertices held on a collider by the solve (contact rows)
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)

@@ -77,7 +77,7 @@ struct ImplicitStats {
   double cgResidual = 0.0;   // relative, at exit
   bool converged = true;     // false: the CG hit cgMaxIterations (or broke down); the step still ran
   bool breakdown = false;    // the system was not positive definite
-  bool factorFailed = false; // the Cholesky preconditioner failed to factor: block Jacobi was used
+  bool factorFailed = false; // the Cholesky or multigrid coarse factor failed: block Jacobi was used
   int constrainedVertices = 0;  // pinned + disturbed
   int contacts = 0;             // vertices held on (contact rows) or pushed out of a collider
   int contactRows = 0;          // vertices held on a collider by the solve (kContactRow)

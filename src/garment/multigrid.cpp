@@ -101,6 +101,8 @@ bool Multigrid::setup(const BlockMatrix& A, const std::vector<uint8_t>& kind, st
   omega_ = 4.0 / (3.0 * std::max(lambda, 1e-12));
   std::vector<int> agg;
   const int m = aggregate(A, kind, agg);
+  ldlt_.reset();
+  if (m == 0) return true;  // every row held: the smoothing alone (exact on identity rows)
   std::vector<Eigen::Triplet<double>> tent;
   tent.reserve(static_cast<size_t>(n) * 9);
   for (int i = 0; i < n; ++i) {
@@ -142,9 +144,11 @@ void Multigrid::apply(const std::vector<Vec3d>& r, std::vector<Vec3d>& s) {
     if (k > 0) res_ = rv - fine_ * x_;
     jacobiSweep();
   }
-  res_ = rv - fine_ * x_;
-  tmp_ = restrict_ * res_;
-  x_ += prolong_ * ldlt_->solve(tmp_);
+  if (ldlt_) {
+    res_ = rv - fine_ * x_;
+    tmp_ = restrict_ * res_;
+    x_ += prolong_ * ldlt_->solve(tmp_);
+  }
   for (int k = 0; k < kSmoothingSweeps; ++k) {
     res_ = rv - fine_ * x_;
     jacobiSweep();

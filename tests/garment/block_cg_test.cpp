@@ -302,10 +302,15 @@ TEST(GarmentCg, IterationCapAndTrivialSystemsAreReported) {
   EXPECT_EQ(still, zero);
   std::vector<Vec3d> held(n, Vec3d(0.5, -1.0, 2.0));
   const std::vector<Vec3d> before = held;
-  res = filteredPcg(A, b, std::vector<uint8_t>(n, 1), held, CgOptions{}, scratch);
-  EXPECT_TRUE(res.converged);
-  EXPECT_EQ(res.iterations, 0);
-  EXPECT_EQ(held, before);
+  for (CgPreconditioner kind : {CgPreconditioner::BlockJacobi, CgPreconditioner::Multigrid}) {  // no coarse level
+    CgOptions opt;
+    opt.preconditioner = kind;
+    res = filteredPcg(A, b, std::vector<uint8_t>(n, 1), held, opt, scratch);
+    EXPECT_TRUE(res.converged);
+    EXPECT_FALSE(res.factorFailed);
+    EXPECT_EQ(res.iterations, 0);
+    EXPECT_EQ(held, before);
+  }
 }
 
 // above 16384 rows the loops run in parallel: the solution is bit for bit the same on 1 and 2 threads,
