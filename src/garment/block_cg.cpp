@@ -94,7 +94,7 @@ CgPreconditioner startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, con
   w.q.resize(static_cast<size_t>(n));
   w.partial.resize(static_cast<size_t>(n));
   CgPreconditioner kind = options.preconditioner;
-  const bool factored = kind == CgPreconditioner::Cholesky    ? w.cholesky.factor(A, filter.kind)
+  const bool factored = kind == CgPreconditioner::Cholesky    ? w.cholesky.factor(A, filter.kind, filter.normal)
                         : kind == CgPreconditioner::Multigrid ? w.multigrid.setup(A, filter.kind, filter.normal)
                                                               : true;
   if (!factored) {

@@ -44,4 +44,12 @@ inline Eigen::Matrix3d filteredDiagonal(uint8_t kind, std::span<const Vec3d> nor
   return s * a * s + (a.trace() / 3.0) * normal[i] * normal[i].transpose();
 }
 
+// block k (row i) of the filtered system: S_i A_ik S_j off the diagonal, filteredDiagonal on it
+inline Eigen::Matrix3d filteredBlock(const BlockMatrix& A, const std::vector<uint8_t>& kind, std::span<const Vec3d> normal,
+                                     int i, int k) {
+  const int j = A.col[k];
+  if (j == i) return filteredDiagonal(kind[i], normal, i, A.block[k]);
+  return filterMatrix(kind[i], normal, i) * A.block[k] * filterMatrix(kind[j], normal, j);
+}
+
 }  // namespace soak

@@ -11,8 +11,8 @@ namespace {
 constexpr int kSmoothingSweeps = 2;  // damped block-Jacobi sweeps before and after the coarse correction
 constexpr int kPowerIterations = 10;  // for lambda_max(D^-1 A), which sets the damping
 
-// the filtered system as scalar entries: S_i A_ij S_j off the diagonal, filteredDiagonal on it (a
-// held row the identity, a contact row's normal decoupled); its diagonal blocks
+// the filtered system as scalar entries (filteredBlock: a held row the identity, a contact row's
+// normal decoupled); its diagonal blocks
 std::vector<Eigen::Triplet<double>> filteredEntries(const BlockMatrix& A, const std::vector<uint8_t>& kind,
                                                     std::span<const Vec3d> normal,
                                                     std::vector<Eigen::Matrix3d>& diagonal) {
@@ -20,11 +20,9 @@ std::vector<Eigen::Triplet<double>> filteredEntries(const BlockMatrix& A, const 
   entries.reserve(A.block.size() * 9);
   diagonal.resize(static_cast<size_t>(A.rows));
   for (int i = 0; i < A.rows; ++i) {
-    const Eigen::Matrix3d si = filterMatrix(kind[i], normal, i);
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) {
       const int j = A.col[k];
-      const Eigen::Matrix3d b = j == i ? filteredDiagonal(kind[i], normal, i, A.block[k])
-                                       : Eigen::Matrix3d(si * A.block[k] * filterMatrix(kind[j], normal, j));
+      const Eigen::Matrix3d b = filteredBlock(A, kind, normal, i, k);
       if (j == i) diagonal[i] = b;
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) entries.emplace_back(3 * i + a, 3 * j + c, b(a, c));

@@ -38,16 +38,16 @@ void SparseCholesky::buildPattern(const BlockMatrix& A) {
   llt_->analyzePattern(lower_);
 }
 
-bool SparseCholesky::factor(const BlockMatrix& A, const std::vector<uint8_t>& constrained) {
+bool SparseCholesky::factor(const BlockMatrix& A, const std::vector<uint8_t>& kind, std::span<const Vec3d> normal) {
   if (A.rowStart != rowStart_ || A.col != col_) buildPattern(A);
   double* values = lower_.valuePtr();
   std::fill(values, values + lower_.nonZeros(), 0.0);
-  forLowerEntries(A, [&](int k, int a, int b, int row, int column) {
-    const int i = row / 3, j = column / 3;
-    const bool filtered = rowHeld(constrained[i]) || rowHeld(constrained[j]);
-    if (filtered && i != j) return;  // a constrained vertex is coupled to nothing
-    values[valueOf_[9 * k + 3 * a + b]] += filtered ? (a == b ? 1.0 : 0.0) : A.block[k](a, b);
-  });
+  for (int i = 0; i < A.rows; ++i)
+    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) {
+      const Eigen::Matrix3d b = filteredBlock(A, kind, normal, i, k);
+      for (int e = 0; e < 9; ++e)  // the lower triangle's entries (two springs between a pair add up)
+        if (valueOf_[9 * k + e] >= 0) values[valueOf_[9 * k + e]] += b(e / 3, e % 3);
+    }
   llt_->factorize(lower_);
   return llt_->info() == Eigen::Success;
 }

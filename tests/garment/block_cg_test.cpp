@@ -145,6 +145,7 @@ TEST(GarmentCg, AContactRowIsHeldAlongItsNormalOnly) {
     opt.preconditioner = pre;
     const CgResult res = filteredPcg(A, b, kind, x, opt, scratch, normal);
     EXPECT_TRUE(res.converged);
+    if (pre == CgPreconditioner::Cholesky) EXPECT_LE(res.iterations, 1);  // it factors the filtered system
     EXPECT_EQ(x[1], z[1]);
     for (int i : {2, 4}) EXPECT_NEAR(x[i].dot(normal[i]), z[i].dot(normal[i]), 1e-12);
     for (int i = 0; i < n; ++i) EXPECT_LT((x[i] - ref.segment<3>(3 * i)).norm(), 1e-9) << "row " << i;
