@@ -208,6 +208,7 @@ void contactRows(const Model& model, const GarmentPiece& g, const std::vector<Co
   const float band = kContactBand * margin;
   w.contactNormal.resize(static_cast<size_t>(g.count));
   w.contactVelocity.resize(static_cast<size_t>(g.count));
+  w.contactImpulse.resize(static_cast<size_t>(g.count));
   w.contactCollider.assign(static_cast<size_t>(g.count), -1);
   parallelFor(numColliders ? g.count : 0, [&](int64_t v) {
     if (w.constrained[v] != kFreeRow) return;
@@ -264,7 +265,8 @@ void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm
   vel = vCol + after;
 }
 
-// the filtered PCG of Eq. 5 with the contact rows; a contact row whose constraint pulled the vertex
+// the filtered PCG of Eq. 5 with the contact rows, each row's impulse n . (A dv - b) after it to
+// w.contactImpulse; a contact row whose constraint pulled the vertex
 // into the collider (a negative impulse: its neighbours lift it off) is released and the system
 // solved again from the last solution (Baraff & Witkin 1998 release a constraint by its force's
 // sign), at most kReleaseRounds times
@@ -282,10 +284,12 @@ void solveWithContact(const GarmentParams& params, ImplicitScratch& w, ImplicitS
     stats.converged = cg.converged;
     stats.breakdown = stats.breakdown || cg.breakdown;
     stats.factorFailed = stats.factorFailed || cg.factorFailed;
+    for (int v = 0; v < w.A.rows; ++v)
+      if (w.constrained[v] == kContactRow) w.contactImpulse[v] = w.contactNormal[v].dot(rowResidual(w.A, w.dv, w.rhs, v));
     if (round == kReleaseRounds) return;
     int released = 0;
     for (int v = 0; v < w.A.rows; ++v) {
-      if (w.constrained[v] != kContactRow || w.contactNormal[v].dot(rowResidual(w.A, w.dv, w.rhs, v)) >= 0.0) continue;
+      if (w.constrained[v] != kContactRow || w.contactImpulse[v] >= 0.0) continue;
       w.constrained[v] = kFreeRow;
       w.contactCollider[v] = -1;
       ++released;
@@ -323,7 +327,7 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
     const int held = w.constrained[v] == kContactRow ? w.contactCollider[v] : -1;
     if (held >= 0) {  // friction with the impulse the contact row applied (its normal velocity is the solve's)
       const Vec3 n = w.contactNormal[v].cast<float>();
-      const float impulse = static_cast<float>(w.contactNormal[v].dot(rowResidual(w.A, w.dv, w.rhs, static_cast<int>(v))));
+      const float impulse = static_cast<float>(w.contactImpulse[v]);
       const Vec3 rel = vel - w.contactVelocity[v];
       const Vec3 after = coulombFriction(rel, n, mixFriction(muFabric, model.colliders[held].friction),
                                          impulse / p.mass[i]);

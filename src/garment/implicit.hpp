@@ -65,6 +65,7 @@ struct ImplicitScratch {
   std::vector<uint8_t> constrained;     // per vertex: 0 free, 1 pinned, 2 disturbed, kContactRow; 3 after the step: in contact
   std::vector<Vec3d> contactNormal;     // per contact row: the collider's unit normal
   std::vector<Vec3> contactVelocity;    // per contact row: the collider's surface velocity (m/s)
+  std::vector<double> contactImpulse;   // per contact row: n . (A dv - b) after the solve (kg m/s)
   std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders

@@ -38,7 +38,7 @@ class Multigrid {
   using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   RowMajor fine_;                         // the filtered A, scalar
   std::vector<Eigen::Matrix3d> diagInv_;  // inverse diagonal blocks of fine_ (the smoother)
-  double omega_ = 0.0;                    // the smoother's damping, 4 / (3 lambda_max(D^-1 A))
+  double omega_ = 0.0;                    // damping of the smoother and of P's smoothing, 4 / (3 lambda_max(D^-1 A))
   RowMajor prolong_;                      // P, 3n x 3m
   RowMajor restrict_;                     // P^T
   Eigen::SparseMatrix<double> coarse_;    // P^T A P
