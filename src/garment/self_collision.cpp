@@ -1,6 +1,8 @@
 // vertex-triangle self-collision of implicit garments (self_collision.hpp)
 #include "garment/self_collision.hpp"
 
+#include "core/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -31,10 +33,21 @@ bool crossedInside(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1,
   return true;
 }
 
+// the common case, without a square root: the vertex is on the same side of the triangle's plane at
+// the start and the end, and at least d from it at the end
+bool clearOnItsSide(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float d) {
+  const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
+  const float dist1raw = (x1[0] - x1[1]).dot(n1raw);  // dist1 |n1raw|
+  const Vec3 n0raw = (x0[2] - x0[1]).cross(x0[3] - x0[1]);
+  const float dist0raw = (x0[0] - x0[1]).dot(n0raw);
+  return n0raw.squaredNorm() > 1e-24f && dist0raw * dist1raw > 0.0f && dist1raw * dist1raw >= d * d * n1raw.squaredNorm();
+}
+
 }  // namespace
 
 bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
                            const std::array<float, 4>& w, float d) {
+  if (clearOnItsSide(x0, x1, d)) return false;
   const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
   const float area2 = n1raw.norm();
   if (!(area2 > 1e-12f)) return false;
@@ -96,6 +109,8 @@ void hashTriangles(const std::vector<std::array<int, 3>>& tris, const Vec3* x1, 
   const size_t nt = tris.size();
   s.cellLo.resize(nt);
   s.cellHi.resize(nt);
+  s.boxLo.resize(nt);
+  s.boxHi.resize(nt);
   s.bucketStart.assign((1u << kBucketBits) + 1, 0);
   for (size_t t = 0; t < nt; ++t) {
     Vec3 lo = x1[tris[t][0]], hi = lo;
@@ -103,6 +118,8 @@ void hashTriangles(const std::vector<std::array<int, 3>>& tris, const Vec3* x1, 
       lo = lo.cwiseMin(x1[tris[t][k]]);
       hi = hi.cwiseMax(x1[tris[t][k]]);
     }
+    s.boxLo[t] = lo - Vec3::Constant(pad);
+    s.boxHi[t] = hi + Vec3::Constant(pad);
     for (int a = 0; a < 3; ++a) {
       s.cellLo[t][a] = static_cast<int>(std::floor((lo[a] - pad) / cell));
       s.cellHi[t][a] = static_cast<int>(std::floor((hi[a] + pad) / cell));
@@ -143,19 +160,69 @@ struct Four {
   }
 };
 
-// calls f(triangle) for every triangle hashed into the cell of point q (and whose box holds it)
+// calls f(triangle) for every triangle whose padded box holds point q (those hashed into q's cell)
 template <typename F>
 void forTrianglesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F&& f) {
-  const int ci = static_cast<int>(std::floor(q.x() / cell)), cj = static_cast<int>(std::floor(q.y() / cell)),
-            ck = static_cast<int>(std::floor(q.z() / cell));
-  const uint32_t b = bucketOf(ci, cj, ck);
+  const uint32_t b = bucketOf(static_cast<int>(std::floor(q.x() / cell)), static_cast<int>(std::floor(q.y() / cell)),
+                              static_cast<int>(std::floor(q.z() / cell)));
   for (uint32_t e = s.bucketStart[b]; e < s.bucketStart[b + 1]; ++e) {
     const int t = s.entry[e];
-    const auto& lo = s.cellLo[t];
-    const auto& hi = s.cellHi[t];
-    if (ci < lo[0] || ci > hi[0] || cj < lo[1] || cj > hi[1] || ck < lo[2] || ck > hi[2]) continue;
+    if ((q.array() < s.boxLo[t].array()).any() || (q.array() > s.boxHi[t].array()).any()) continue;
     f(t);
   }
+}
+
+}  // namespace
+
+namespace {
+
+constexpr int64_t kVertexChunk = 256;
+// a pair is kept while its vertex is closer than this many thicknesses to the triangle's plane (or
+// on the other side), its projection less than one thickness fewer outside the triangle: a pair left
+// out needs more than a thickness of motion (a push's most) to come within reach of the push
+constexpr float kNearThicknesses = 2.0f;
+
+// whether the vertex's projection on the triangle's plane lies within `near` of the triangle (the
+// push acts only on a projection inside it): a sheet's own neighbouring triangles, nearly in the
+// vertex's plane, are not kept
+bool projectsNear(const std::array<Vec3, 4>& x1, float near) {
+  const Vec3 n = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
+  const float area2 = n.norm();
+  if (!(area2 > 1e-12f)) return true;
+  for (int k = 1; k <= 3; ++k) {
+    const Vec3& u = x1[k % 3 + 1];
+    const Vec3& t = x1[(k + 1) % 3 + 1];
+    // (u - x) x (t - x) . n / |n| is the projection's signed distance to the edge's line times |t - u|
+    if ((u - x1[0]).cross(t - x1[0]).dot(n) < -near * area2 * (t - u).norm()) return false;
+  }
+  return true;
+}
+
+// the step's proximity pairs (vertex, triangle), in vertex order: every free vertex with every
+// triangle whose padded box holds it and that does not hold its seam group, unless it is clear by
+// kNearThicknesses on its side or its projection is one thickness less far outside the triangle. Chunks of vertices in parallel, joined in order: the same pairs for
+// any thread count
+void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int count,
+               const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1, float cell, float thickness,
+               SelfCollisionScratch& s) {
+  const float near = kNearThicknesses * thickness, outside = near - thickness;
+  const int64_t chunks = (count + kVertexChunk - 1) / kVertexChunk;
+  fillChunks(chunks, s.chunkPairs, omp_get_max_threads(), [] { return 0; },
+             [&](int, int64_t c, std::vector<std::array<int, 2>>& out) {
+               const int end = static_cast<int>(std::min<int64_t>(count, (c + 1) * kVertexChunk));
+               for (int i = static_cast<int>(c * kVertexChunk); i < end; ++i) {
+                 if (invMass[i] == 0.0f) continue;
+                 forTrianglesAt(x1[i], cell, s, [&](int t) {
+                   const auto& tri = tris[t];
+                   if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
+                   const std::array<Vec3, 4> a0{x0[i], x0[tri[0]], x0[tri[1]], x0[tri[2]]};
+                   const std::array<Vec3, 4> a1{x1[i], x1[tri[0]], x1[tri[1]], x1[tri[2]]};
+                   if (!clearOnItsSide(a0, a1, near) && projectsNear(a1, outside)) out.push_back({i, t});
+                 });
+               }
+             });
+  s.pairs.clear();
+  for (int64_t c = 0; c < chunks; ++c) s.pairs.insert(s.pairs.end(), s.chunkPairs[c].begin(), s.chunkPairs[c].end());
 }
 
 }  // namespace
@@ -169,24 +236,21 @@ int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<i
   float edge = 0.0f;
   for (const auto& t : tris) edge += (x1[t[1]] - x1[t[0]]).norm();
   s.moved.assign(static_cast<size_t>(count), 0);
-  int pushes = 0;
   // a vertex within the thickness of a triangle lies in its box padded by the thickness; the boxes
   // are built once, so the pad holds another thickness for the pushes of the passes. Not the step's
   // motion: a fast garment would make the cells, and every candidate list, as large as the piece
   const float pad = 2.0f * thickness;
   const float cell = std::max(edge / float(tris.size()), 2.0f * pad);
   hashTriangles(tris, x1, cell, pad, s);
+  findPairs(tris, group, count, invMass, x0, x1, cell, thickness, s);
+  int pushes = 0;
   for (int pass = 0; pass < kPasses; ++pass) {
-    for (int i = 0; i < count; ++i) {
-      if (invMass[i] == 0.0f) continue;
-      forTrianglesAt(x1[i], cell, s, [&](int t) {
-        const auto& tri = tris[t];
-        if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
-        Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
-        if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) return;
-        f.store(x1, vel, s.moved);
-        ++pushes;
-      });
+    for (const auto& [i, t] : s.pairs) {
+      const auto& tri = tris[t];
+      Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
+      if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) continue;
+      f.store(x1, vel, s.moved);
+      ++pushes;
     }
   }
   return pushes;

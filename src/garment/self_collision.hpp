@@ -6,8 +6,10 @@
 // the triangle (round its edge) keeps its new side, and a push closes at most one thickness. Edge-edge proximity is not tested:
 // two edges can still pass through each other between the vertices. The push is shared by the vertex and
 // the triangle's three vertices by inverse mass and barycentric weight (momentum is kept), and their
-// velocity towards each other along the triangle's normal is removed (inelastic). Gauss-Seidel over
-// the vertices in index order, serial: the result does not depend on the thread count.
+// velocity towards each other along the triangle's normal is removed (inelastic). The pairs within
+// reach (closer than 2 d to the plane, projecting less than d outside the triangle) are found once
+// per step, by chunks of vertices in parallel joined in order; the passes are Gauss-Seidel over those
+// pairs in vertex order, serial: the result does not depend on the thread count.
 #pragma once
 #include <soak/math.hpp>
 #include <soak/model.hpp>
@@ -23,6 +25,9 @@ struct SelfCollisionScratch {
   std::vector<uint32_t> bucketStart;  // triangles of hash bucket b: entry[bucketStart[b] .. bucketStart[b + 1])
   std::vector<int> entry;
   std::vector<std::array<int, 3>> cellLo, cellHi;  // each triangle's cell range
+  std::vector<Vec3> boxLo, boxHi;                  // each triangle's padded box
+  std::vector<std::array<int, 2>> pairs;            // the step's proximity pairs (vertex, triangle)
+  std::vector<std::vector<std::array<int, 2>>> chunkPairs;  // per chunk of vertices, joined into pairs
   std::vector<uint8_t> moved;                      // per vertex of the piece: pushed this step
 };
 
@@ -34,7 +39,7 @@ bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x
                            const std::array<float, 4>& w, float d);
 
 // three Gauss-Seidel passes over the piece's particles [first, first + count): every vertex against the local
-// triangles `tris`. Seam groups `group` (vertices seamed together share a group): a triangle holding
+// triangles `tris` within its reach. Seam groups `group` (vertices seamed together share a group): a triangle holding
 // the vertex's group is not tested. Inverse masses `invMass` (0: pinned or disturbed). Positions p.x (start) and p.xPred (end),
 // velocities p.v. Marks the vertices it moved in s.moved. Returns the pushes made.
 int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int first, int count, const std::vector<float>& invMass,
