@@ -10,18 +10,6 @@ namespace soak {
 
 namespace {
 
-// one CG iteration is a few hundred flops per row: below this many rows its loops run on the calling
-// thread, where three forks per iteration cost more than the work (much more on a busy machine)
-constexpr int64_t kCgParallelRows = 16384;
-
-template <class F>
-void rowsFor(int64_t n, F&& body) {
-  if (n >= kCgParallelRows)
-    parallelFor(n, body);
-  else
-    for (int64_t i = 0; i < n; ++i) body(i);
-}
-
 // sum of per-row terms in row order: the same for any thread count
 double orderedSum(const std::vector<double>& terms) {
   double s = 0.0;
@@ -33,7 +21,7 @@ double orderedSum(const std::vector<double>& terms) {
 
 void BlockMatrix::multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) const {
   y.resize(static_cast<size_t>(rows));
-  rowsFor(rows, [&](int64_t i) {
+  parallelFor(rows, [&](int64_t i) {
     Vec3d sum = Vec3d::Zero();
     for (int k = rowStart[i]; k < rowStart[i + 1]; ++k) sum += block[k] * x[col[k]];
     y[i] = sum;
@@ -42,7 +30,7 @@ void BlockMatrix::multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) c
 
 double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::vector<double>& partial) {
   partial.resize(a.size());
-  rowsFor(static_cast<int64_t>(a.size()), [&](int64_t i) { partial[i] = a[i].dot(b[i]); });
+  parallelFor(static_cast<int64_t>(a.size()), [&](int64_t i) { partial[i] = a[i].dot(b[i]); });
   return orderedSum(partial);
 }
 
@@ -76,7 +64,7 @@ double precondition(const std::vector<Vec3d>& r, const Filter& filter, CgPrecond
   s.resize(r.size());
   if (kind == CgPreconditioner::Cholesky) w.cholesky.solve(r, s);
   if (kind == CgPreconditioner::Multigrid) w.multigrid.apply(r, s);
-  rowsFor(n, [&](int64_t i) {
+  parallelFor(n, [&](int64_t i) {
     s[i] = filter(i, kind == CgPreconditioner::BlockJacobi ? Vec3d(w.precond[i] * r[i]) : s[i]);
     w.partial[i] = r[i].dot(s[i]);
   });
@@ -102,9 +90,9 @@ CgPreconditioner startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, con
     kind = CgPreconditioner::BlockJacobi;
   }
   if (kind == CgPreconditioner::BlockJacobi) invertDiagonal(A, filter, w);
-  rowsFor(n, [&](int64_t i) { w.r[i] = filter(i, b[i]); });
+  parallelFor(n, [&](int64_t i) { w.r[i] = filter(i, b[i]); });
   delta0 = precondition(w.r, filter, kind, w, w.s);
-  rowsFor(n, [&](int64_t i) {  // r = filter(b - A x)
+  parallelFor(n, [&](int64_t i) {  // r = filter(b - A x)
     Vec3d ax = Vec3d::Zero();
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) ax += A.block[k] * x[A.col[k]];
     w.r[i] = filter(i, b[i] - ax);
@@ -133,7 +121,7 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
   const double tol2 = options.tolerance * options.tolerance;
   while (deltaNew > tol2 * delta0 && result.iterations < options.maxIterations) {
     // q = filter(A c)
-    rowsFor(n, [&](int64_t i) {
+    parallelFor(n, [&](int64_t i) {
       if (rowHeld(constrained[i])) {
         w.q[i].setZero();
         w.partial[i] = 0.0;
@@ -151,14 +139,14 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
     }
     const double alpha = deltaNew / cq;
     // x += alpha c, r -= alpha q (filtered rows of c, q, r are zero), s = filter(P^-1 r)
-    rowsFor(n, [&](int64_t i) {
+    parallelFor(n, [&](int64_t i) {
       x[i] += alpha * w.c[i];
       w.r[i] -= alpha * w.q[i];
     });
     const double deltaOld = deltaNew;
     deltaNew = precondition(w.r, filter, kind, w, w.s);
     const double beta = deltaNew / deltaOld;
-    rowsFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
+    parallelFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
     ++result.iterations;
   }
   result.residual = std::sqrt(std::max(deltaNew, 0.0) / delta0);

@@ -314,7 +314,7 @@ TEST(GarmentCg, IterationCapAndTrivialSystemsAreReported) {
   }
 }
 
-// above 16384 rows the loops run in parallel: the solution is bit for bit the same on 1 and 2 threads,
+// above kParallelGrain rows the loops run in parallel: the solution is bit for bit the same on 1 and 2 threads,
 // and it solves the system (a 20000-row block tridiagonal matrix, a few ms a solve)
 TEST(GarmentCg, SameSolutionOnOneAndTwoThreadsForALargeSystem) {
   const int n = 20000;
