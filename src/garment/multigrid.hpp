@@ -5,9 +5,12 @@
 // system P^T A P is factored exactly. One symmetric V-cycle (damped block-Jacobi smoothing before
 // and after the coarse correction) is the preconditioner: the smoothing removes the stiff springs'
 // short-wavelength error, the coarse level the long-wavelength sag that block Jacobi alone needs
-// hundreds of iterations for. It works on the filtered matrix: a held row is the identity and
-// takes no part in the coarse level, a contact row is restricted to its tangent plane.
+// hundreds of iterations for. It works on the filtered matrix S A S (filterRow): a held row takes no
+// part, a contact row is restricted to its tangent plane. Everything but the coarse factor works on
+// 3x3 blocks, row by row in parallel, each sum in a fixed order: the result does not depend on the
+// thread count.
 #pragma once
+#include "core/parallel.hpp"
 #include "garment/block_matrix.hpp"
 
 #include <Eigen/SparseCholesky>
@@ -19,6 +22,13 @@
 
 namespace soak {
 
+// rows of 3x3 blocks in arbitrary columns: row i holds blocks [start[i], start[i + 1]) in columns col[k]
+struct BlockRows {
+  std::vector<int> start{0};
+  std::vector<int> col;
+  std::vector<Eigen::Matrix3d> block;
+};
+
 class Multigrid {
  public:
   Multigrid() = default;
@@ -28,25 +38,39 @@ class Multigrid {
   Multigrid(Multigrid&&) = default;
   Multigrid& operator=(Multigrid&&) = default;
   // builds the levels for A filtered by each row's kind (filterRow; normal: the contact rows' unit
-  // normals); false when the coarse system does not factor (the caller falls back to block Jacobi)
+  // normals); false when the coarse system does not factor (the caller falls back to block Jacobi).
+  // A, kind and normal are read again by apply(): they must outlive it unchanged.
   bool setup(const BlockMatrix& A, const std::vector<uint8_t>& kind, std::span<const Vec3d> normal);
-  // s = one V-cycle applied to r (a symmetric positive definite approximation of the filtered A's
-  // inverse on the free part; the caller filters s)
+  // s = one V-cycle applied to the filtered r (a symmetric positive definite approximation of the
+  // filtered A's inverse on the free part; s is filtered too)
   void apply(const std::vector<Vec3d>& r, std::vector<Vec3d>& s);
 
  private:
-  using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-  RowMajor fine_;                         // the filtered A, scalar
-  std::vector<Eigen::Matrix3d> diagInv_;  // inverse diagonal blocks of fine_ (the smoother)
+  const BlockMatrix* fine_ = nullptr;      // A of the last setup, filtered in every product
+  const std::vector<uint8_t>* kind_ = nullptr;
+  std::span<const Vec3d> normal_;
+  std::vector<Eigen::Matrix3d> diagInv_;  // inverse filtered diagonal blocks (the smoother)
   double omega_ = 0.0;                    // damping of the smoother and of P's smoothing, 4 / (3 lambda_max(D^-1 A))
-  RowMajor prolong_;                      // P, 3n x 3m
-  RowMajor restrict_;                     // P^T
-  Eigen::SparseMatrix<double> coarse_;    // P^T A P
+  std::vector<int> agg_;                  // each vertex's aggregate, -1 for a held row
+  BlockRows prolong_;                     // P: a row per vertex, a column per aggregate
+  BlockRows restrict_;                    // P^T: a row per aggregate, a column per vertex
+  BlockRows product_;                     // S A S P, a row per vertex
+  BlockRows coarseBlocks_;                // P^T S A S P, a row per aggregate
+  Eigen::SparseMatrix<double> coarse_;    // its lower triangle, scalar
   using Ldlt = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
   std::unique_ptr<Ldlt> ldlt_;            // on the heap: Eigen's solvers cannot be moved
-  Eigen::VectorXd x_, res_, tmp_;         // V-cycle work vectors
+  std::vector<Vec3d> x_, res_, tmp_;      // V-cycle work vectors
+  Eigen::VectorXd coarseRhs_, coarseX_;
+  ThreadBuffers<int> columnScratch_;       // each thread's column list while rows are built
+  std::vector<int> rowStart_, col_;        // A's pattern at the last setup
+  bool samePattern_ = false;               // this setup's patterns are the last one's
 
-  void jacobiSweep();  // x_ += omega D^-1 res_ (res_ = r - A x_)
+  void residual(const std::vector<Vec3d>& r);     // res_ = r - S A S x_
+  void jacobiSweep(const std::vector<Vec3d>& r);  // x_ += omega D^-1 (r - S A S x_)
+  void coarseCorrection();                     // x_ += P (P^T A P)^-1 P^T res_
+  double largestEigenvalue();                  // lambda_max(D^-1 S A S), power iteration
+  void buildProlongation();                    // prolong_ and restrict_ from agg_
+  void buildCoarse(int aggregates);            // coarse_ = P^T S A S P
 };
 
 }  // namespace soak
