@@ -13,7 +13,7 @@
 namespace soak {
 
 // bumped whenever the file's layout or the State's fields change; a file of another format is refused
-inline constexpr uint32_t kCheckpointFormat = 1;
+inline constexpr uint32_t kCheckpointFormat = 2;
 
 // where in the run a checkpoint's state is
 struct CheckpointInfo {

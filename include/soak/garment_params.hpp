@@ -92,6 +92,7 @@ struct GarmentParams {
   float cgTolerance = 1e-4f;          // relative preconditioned residual
   int cgMaxIterations = 300;
   CgPreconditioner cgPreconditioner = CgPreconditioner::BlockJacobi;
+  bool cgWarmStart = false;           // the CG starts from the last substep's velocity change (State::clothVelocityChange)
   bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
 };
 

@@ -69,6 +69,10 @@ struct State {
   // Chen 2012: the time each cloth particle first got wet (+infinity: dry); one entry per cloth
   // particle when a piece has wetByContact, else empty
   std::vector<float> clothWetStart;
+  // Chen 2012 implicit pieces: each cloth particle's velocity change in the last implicit substep
+  // (m/s), the next solve's initial guess (garment.cg.warmStart); one entry per cloth particle when a
+  // piece is implicit, else empty
+  std::vector<Vec3> clothVelocityChange;
   // PBF iterations the last substep took: the iterations to solver.fluidTolerance go below it only
   // with a margin (stopIterating, docs/models.md "Eq. 6-7 iterated to a tolerance")
   int fluidIterations = 0;

@@ -239,7 +239,7 @@ void contactRows(const Model& model, const GarmentPiece& g, const std::vector<Co
     w.constrained[v] = kContactRow;
     w.contactNormal[v] = n;
     w.contactVelocity[v] = vCol;
-    w.dv[v] = (vn - v0.dot(n)) * n;  // the prescribed normal part; the tangential part starts at 0
+    w.dv[v] = (vn - v0.dot(n)) * n + (w.dv[v] - w.dv[v].dot(n) * n);  // prescribed normal, guessed tangential part
   });
   for (int v = 0; v < g.count; ++v) stats.contactRows += w.constrained[v] == kContactRow ? 1 : 0;
 }
@@ -426,7 +426,8 @@ float seamOpenFraction(const SeamParams& seams, double time) {
 
 ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h, double time,
                            const std::vector<ColliderPose>& poses, std::span<const float> saturation,
-                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w) {
+                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w,
+                           std::span<Vec3> velocityChange) {
   ImplicitStats stats;
   const double hd = h;
   const bool sewn = g.springs.kindStart[4] > g.springs.kindStart[3];
@@ -436,9 +437,14 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   const bool frictionless = sewn && time < params.seams.closeTime + params.seams.settleTime;
   springForces(g, params, seamOpenFraction(params.seams, time), p, w, stats);
   constrainRows(model, g, constraints, p, hd, w, stats);
+  const bool warm = params.cgWarmStart && velocityChange.size() == static_cast<size_t>(g.count);
+  for (int v = 0; warm && v < g.count; ++v)  // the free rows start from the last step's dv (warm start)
+    if (w.constrained[v] == kFreeRow) w.dv[v] = velocityChange[v].cast<double>();
   assembleSystem(model, g, params, p, hd, sewing && !params.seams.gravityWhileClosing ? 0.0 : 1.0, w);
   contactRows(model, g, poses, p, h, w, stats);
   solveWithContact(params, w, stats);
+  if (velocityChange.size() == static_cast<size_t>(g.count))
+    for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
   integrateWithContact(model, g, params, h, frictionless, poses, saturation, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision)
@@ -449,11 +455,13 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
 
 ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
                              std::span<const float> saturation, float h, double time, uint64_t stepIndex,
-                             const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch) {
+                             const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch,
+                             std::span<Vec3> velocityChange) {
   if (params.saturationMass) applySaturationMass(model, g.piece, saturation, params.saturation, p);  // Eq. 15-19
   const std::vector<PositionConstraint> wrinkles = computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses,
                                                                        params.wrinkles, stepIndex, saturation);  // 3.5
-  ImplicitStats s = implicitStep(model, g, params, h, time, poses, saturation, wrinkles, p, scratch);  // Eq. 1-5
+  ImplicitStats s =
+      implicitStep(model, g, params, h, time, poses, saturation, wrinkles, p, scratch, velocityChange);  // Eq. 1-5
   s.disturbances = static_cast<int>(wrinkles.size());
   return s;
 }

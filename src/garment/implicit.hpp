@@ -91,17 +91,22 @@ struct ImplicitStats {
 // one implicit step of length h from `time` for the piece (see the header comment); seams pull towards
 // their starting gap times max(0, 1 - time / closeTime), and gravity is off while they close unless
 // params.seams.gravityWhileClosing. saturation (piece-local, in [0, 1], empty = all dry) sets each
-// vertex's friction with wetFriction; poses are the colliders at time + h. Deterministic for any
-// thread count.
+// vertex's friction with wetFriction; poses are the colliders at time + h. velocityChange (piece-local,
+// State::clothVelocityChange) holds the last step's dv: the solve starts from it when
+// params.cgWarmStart, and it receives this step's; empty: a cold start. Deterministic for any thread
+// count.
 ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h, double time,
                            const std::vector<ColliderPose>& poses, std::span<const float> saturation,
-                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& scratch);
+                           const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& scratch,
+                           std::span<Vec3> velocityChange = {});
 
 // the garment stage of one piece for one step of length h from `time` (s; it paces the seams'
-// closing, SeamParams) (see the header comment); stepIndex paces the wrinkle disturbances
+// closing, SeamParams) (see the header comment); stepIndex paces the wrinkle disturbances;
+// velocityChange as for implicitStep
 ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const GarmentParams& params,
                              std::span<const float> saturation, float h, double time, uint64_t stepIndex,
-                             const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch);
+                             const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch,
+                             std::span<Vec3> velocityChange = {});
 
 // kinetic + gravitational + elastic energy of the piece (J), for tests and diagnostics
 double garmentEnergy(const Model& model, const GarmentPiece& g, const GarmentParams& params, const Particles& p);

@@ -195,8 +195,12 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
       continue;
     }
     if (!piece.implicit) continue;  // a Model built without the loader's buildGarmentPieces
+    const std::span<Vec3> velocityChange =
+        state.clothVelocityChange.empty()
+            ? std::span<Vec3>()
+            : std::span<Vec3>(state.clothVelocityChange).subspan(size_t(piece.firstParticle), size_t(piece.particleCount));
     const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, saturation, h, state.time,
-                                           state.stepCount, poses, p, s.scratch[k]);
+                                           state.stepCount, poses, p, s.scratch[k], velocityChange);
     ++gs.solves;
     gs.cgIterations += static_cast<uint64_t>(r.cgIterations);
     gs.cgIterationsMax = std::max(gs.cgIterationsMax, r.cgIterations);

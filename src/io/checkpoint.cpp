@@ -110,7 +110,7 @@ void writeState(Writer& w, const State& s) {
   w.value(uint64_t{s.emitters.size()});
   for (const EmitterState& e : s.emitters) w.value(e.emittedLength), w.value(e.dropsEmitted), w.value(uint8_t{e.done});
   w.array(s.clothWater), w.array(s.clothBuffer), w.array(s.clothSaturation);
-  w.array(s.dripId), w.array(s.dripSource), w.array(s.clothWetStart);
+  w.array(s.dripId), w.array(s.dripSource), w.array(s.clothWetStart), w.array(s.clothVelocityChange);
 }
 
 void readParticles(Reader& r, Particles& p) {
@@ -144,6 +144,7 @@ void readState(Reader& r, State& s) {
   r.array(s.clothWater, "clothWater"), r.array(s.clothBuffer, "clothBuffer");
   r.array(s.clothSaturation, "clothSaturation"), r.array(s.dripId, "dripId"), r.array(s.dripSource, "dripSource");
   r.array(s.clothWetStart, "clothWetStart");
+  r.array(s.clothVelocityChange, "clothVelocityChange");
 }
 
 // the whole file in memory, refusing what is not a regular file (a device or a pipe never ends)
@@ -239,6 +240,9 @@ void checkCheckpointFits(const std::string& path, const Checkpoint& c, const Mod
     fail(fmt::format("wetting arrays of {} entries, expected {}", s.clothWater.size(), wet));
   if (s.clothWetStart.size() != (chen ? nc : 0))
     fail(fmt::format("{} wet start times, expected {}", s.clothWetStart.size(), chen ? nc : 0));
+  if (s.clothVelocityChange.size() != (model.hasImplicitCloth() ? nc : 0))
+    fail(fmt::format("{} implicit velocity changes, expected {}", s.clothVelocityChange.size(),
+                     model.hasImplicitCloth() ? nc : 0));
   if (s.dripId.size() != s.dripSource.size()) fail("drip arrays of different lengths");
 }
 

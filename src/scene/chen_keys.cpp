@@ -112,6 +112,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));
   g.cgPreconditioner = static_cast<CgPreconditioner>(
       cg.choice("preconditioner", {"blockJacobi", "cholesky", "multigrid"}, std::string("blockJacobi")));
+  g.cgWarmStart = cg.boolean("warmStart", d.cgWarmStart);
   cg.finish();
   ObjectReader w = r.object("wrinkles");
   g.wrinkles.enabled = w.boolean("enabled", w.present());

@@ -497,6 +497,7 @@ void initState(ErrorLog& log, const Model& model, const std::vector<ClothSpec>& 
   state.emitters.resize(model.emitters.size());
   for (const ClothPiece& piece : model.pieces)
     if (piece.wetByContact) state.clothWetStart.assign(size_t(model.numCloth), std::numeric_limits<float>::infinity());
+  if (model.hasImplicitCloth()) state.clothVelocityChange.assign(size_t(model.numCloth), Vec3::Zero());
   if (!state.clothWetStart.empty() && !model.wetting.enabled) {  // Chen's saturation: water held, s per vertex
     state.clothWater.assign(size_t(model.numCloth), 0.0);
     state.clothBuffer.assign(size_t(model.numCloth), 0.0);

@@ -72,6 +72,7 @@ uint64_t stateHash(const State& state) {
   hashBytes(h, state.dripId);
   hashBytes(h, state.dripSource);
   hashBytes(h, state.clothWetStart);
+  hashBytes(h, state.clothVelocityChange);
   return h;
 }
 

@@ -3,6 +3,7 @@
 // foreign file is refused with an error naming it and what is wrong
 #include <soak/checkpoint.hpp>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <soak/error.hpp>
@@ -46,12 +47,13 @@ struct Case {
 // a new Workspace: the same state hash. The scenes cover drips hanging from a pre-wetted cloth and
 // let go (Fig. 6, 2 drips at step 3, 80 at step 4), a jet on a wetting cloth that starts absorbing
 // (Fig. 1, steps 9-12), the water's sort (every 10 steps) and an implicit garment in the rain with
-// its wet start times (Chen Fig. 8); the cloths coarser than shipped, to keep the test short
+// its wet start times and its warm-started solve's last velocity changes (Chen Fig. 8); the cloths
+// coarser than shipped, to keep the test short
 TEST(Checkpoint, AResumedRunEqualsTheUnbrokenOne) {
   const fs::path dir = tempDir("checkpoint_resume");
   for (const Case& c : {Case{"scenes/fig6a_drip_uniform.json", {"cloth.0.mesh.resolution=[80,80]"}, 3, 4},
                         Case{"scenes/fig1_jet.json", {"cloth.0.mesh.resolution=[40,40]"}, 9, 3},
-                        Case{"scenes/chen_fig8_silk_sphere_wet.json", {}, 4, 4}}) {
+                        Case{"scenes/chen_fig8_silk_sphere_wet.json", {"cloth.0.garment.cg.warmStart=true"}, 4, 4}}) {
     SCOPED_TRACE(c.scene);
     Scene unbroken = sceneFromFile(c.scene, c.overrides);
     WorkspacePtr ws = makeWorkspace();
@@ -110,7 +112,7 @@ TEST(Checkpoint, DamagedOrForeignFilesAreRefusedNamingTheFile) {
   std::string other = bytes;
   other[8] = 99;  // the format number follows the 8-byte magic
   const std::string format = variant("format.soak", other);
-  expectError([&] { readCheckpoint(format); }, {format, "format 99", "format 1"});
+  expectError([&] { readCheckpoint(format); }, {format, "format 99", fmt::format("format {}", kCheckpointFormat)});
   const std::string cut = variant("cut.soak", bytes.substr(0, bytes.size() / 2));
   expectError([&] { readCheckpoint(cut); }, {cut, "truncated"});
   std::string flipped = bytes;
@@ -152,7 +154,8 @@ TEST(Checkpoint, AStateOfAnotherSceneDoesNotFit) {
   expectError([&] { checkCheckpointFits(path, c, b.model); }, {path, "does not belong to this scene"});
   const Scene chen = sceneFromFile("scenes/chen_fig8_silk_sphere_wet.json");
   expectError([&] { checkCheckpointFits(path, c, chen.model); }, {path, "does not belong to this scene"});
-  // a Chen piece keeps its held water, saturation and wet times: a state without them does not fit
+  // a Chen piece keeps its held water, saturation, wet times and the implicit solve's velocity
+  // changes: a state without them does not fit
   const std::string chenPath = (dir / "chen.soak").string();
   writeCheckpoint(chenPath, infoAt(0, 0), chen.state);
   Checkpoint cc = readCheckpoint(chenPath);
@@ -164,6 +167,10 @@ TEST(Checkpoint, AStateOfAnotherSceneDoesNotFit) {
   cc = readCheckpoint(chenPath);
   cc.state.clothWetStart.clear();
   expectError([&] { checkCheckpointFits(chenPath, cc, chen.model); }, {chenPath, "0 wet start times, expected 2601"});
+  cc = readCheckpoint(chenPath);
+  cc.state.clothVelocityChange.pop_back();
+  expectError([&] { checkCheckpointFits(chenPath, cc, chen.model); },
+              {chenPath, "2600 implicit velocity changes, expected 2601"});
 }
 
 }  // namespace

@@ -270,7 +270,7 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   const Scene s = fromString(kSheet, {R"(cloth.0.garment={"stretch": {"a1": 700, "a2": 2}, "shear": {"a1": 60, "a2": 0.5},
       "bend": {"a1": 3, "a2": 1}, "strainLimit": 0.7, "bendStraightness": 0.6,
       "friction": {"dry": 0.2, "peak": 0.9, "plateau": 0.4, "peakSaturation": 0.15, "plateauSaturation": 0.8},
-      "rayleigh": {"alpha": 0.5, "beta": 0.001}, "cg": {"tolerance": 1e-6, "maxIterations": 77, "preconditioner": "cholesky"},
+      "rayleigh": {"alpha": 0.5, "beta": 0.001}, "cg": {"tolerance": 1e-6, "maxIterations": 77, "preconditioner": "cholesky", "warmStart": true},
       "wrinkles": {"compressionThreshold": 0.1, "equilibriumSpeed": 0.3, "interval": 4, "patchSize": 50,
                    "tieTolerance": 0.01, "strength": 0.5, "dryStrength": 0.25, "seed": 9}})"});
   const GarmentParams& g = s.model.pieces[0].garment;
@@ -290,6 +290,7 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_FLOAT_EQ(g.cgTolerance, 1e-6f);
   EXPECT_EQ(g.cgMaxIterations, 77);
   EXPECT_EQ(g.cgPreconditioner, CgPreconditioner::Cholesky);
+  EXPECT_TRUE(g.cgWarmStart);
   EXPECT_TRUE(g.wrinkles.enabled);
   EXPECT_FLOAT_EQ(g.wrinkles.compressionThreshold, 0.1f);
   EXPECT_FLOAT_EQ(g.wrinkles.equilibriumSpeed, 0.3f);
@@ -307,6 +308,8 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_EQ(d.friction.peak, defaults.friction.peak);
   EXPECT_EQ(d.cgMaxIterations, defaults.cgMaxIterations);
   EXPECT_EQ(d.cgPreconditioner, CgPreconditioner::BlockJacobi);
+  EXPECT_EQ(d.cgWarmStart, defaults.cgWarmStart);
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.cg.warmStart=1"}), "at cloth[0].garment.cg.warmStart");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.cg.preconditioner=ilu"}),
              "at cloth[0].garment.cg.preconditioner: expected one of \"blockJacobi\", \"cholesky\"");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.wrinkles.patchSize=2"}),
