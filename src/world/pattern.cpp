@@ -189,8 +189,52 @@ std::vector<Vec2d> buildRing(const PatternPanel& p, int panel, std::vector<Stret
   return ring;
 }
 
+// the constrained Delaunay triangles of the points (the ring's first, then the rest) inside the
+// ring, built from scratch in that order, each listed from its lowest vertex, in ascending order:
+// the same triangles for the same points in any process (the mesher's own triangulation and face
+// order depend on where its handles were allocated: a --set override changed the T-shirt's mesh)
+void triangulatePoints(const std::vector<Vec2d>& points, size_t ringSize, const std::string& where,
+                       std::vector<std::array<int, 3>>& triangles) {
+  Cdt cdt;
+  std::map<Cdt::Vertex_handle, int> index;
+  std::vector<Cdt::Vertex_handle> handle;
+  for (size_t k = 0; k < points.size(); ++k) {
+    handle.push_back(cdt.insert(Cdt::Point(points[k].x(), points[k].y())));
+    index[handle.back()] = static_cast<int>(k);
+  }
+  for (size_t k = 0; k < ringSize; ++k) cdt.insert_constraint(handle[k], handle[(k + 1) % ringSize]);
+  // outside: the faces reached from the infinite ones without crossing the outline
+  std::set<Cdt::Face_handle> outside;
+  std::vector<Cdt::Face_handle> todo;
+  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+    if (cdt.is_infinite(f) && outside.insert(f).second) todo.push_back(f);
+  while (!todo.empty()) {
+    const Cdt::Face_handle f = todo.back();
+    todo.pop_back();
+    for (int k = 0; k < 3; ++k)
+      if (!cdt.is_constrained({f, k}) && outside.insert(f->neighbor(k)).second) todo.push_back(f->neighbor(k));
+  }
+  triangles.clear();
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+    if (outside.count(f)) continue;
+    std::array<int, 3> t{index[f->vertex(0)], index[f->vertex(1)], index[f->vertex(2)]};  // counter-clockwise
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    triangles.push_back(t);
+  }
+  std::sort(triangles.begin(), triangles.end());
+  std::map<std::pair<int, int>, int> edgeUses;
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) ++edgeUses[std::minmax(t[k], t[(k + 1) % 3])];
+  const size_t boundaryEdges = static_cast<size_t>(
+      std::count_if(edgeUses.begin(), edgeUses.end(), [](const auto& e) { return e.second == 1; }));
+  if (boundaryEdges != ringSize || index.size() != points.size())
+    throw Error(fmt::format("{}: internal error: the mesher changed the outline ({} boundary edges, {} outline "
+                            "points)", where, boundaryEdges, ringSize));
+}
+
 // triangulates the ring (CGAL constrained Delaunay, refined to edgeLength without Steiner points on
-// the outline, then Lloyd-smoothed); the first ring.size() vertices are the ring's, in order
+// the outline, then Lloyd-smoothed); the first ring.size() vertices are the ring's, in order, the
+// mesher's own after them in ascending (x, y)
 void triangulateRing(const std::vector<Vec2d>& ring, double edgeLength, const std::string& where,
                      std::vector<Vec2d>& vertices, std::vector<std::array<int, 3>>& triangles) {
   Cdt cdt;
@@ -202,24 +246,16 @@ void triangulateRing(const std::vector<Vec2d>& ring, double edgeLength, const st
   Mesher mesher(cdt, Criteria(0.125, 1.5 * edgeLength));
   mesher.refine_mesh();
   CGAL::lloyd_optimize_mesh_2(cdt, CGAL::parameters::max_iteration_number = 10);
-  std::map<Cdt::Vertex_handle, int> index;
-  for (size_t k = 0; k < handle.size(); ++k) index[handle[k]] = static_cast<int>(k);
+  const std::set<Cdt::Vertex_handle> onRing(handle.begin(), handle.end());
+  std::vector<Vec2d> inner;
+  for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
+    if (!onRing.count(v)) inner.emplace_back(v->point().x(), v->point().y());
+  std::sort(inner.begin(), inner.end(), [](const Vec2d& a, const Vec2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
   vertices = ring;
-  for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
-    if (index.count(v)) continue;
-    index[v] = static_cast<int>(vertices.size());
-    vertices.emplace_back(v->point().x(), v->point().y());
-  }
-  triangles.clear();
-  size_t boundaryEdges = 0;
-  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-    if (!f->is_in_domain()) continue;
-    triangles.push_back({index[f->vertex(0)], index[f->vertex(1)], index[f->vertex(2)]});  // counter-clockwise
-    for (int k = 0; k < 3; ++k) boundaryEdges += f->neighbor(k)->is_in_domain() && !cdt.is_infinite(f->neighbor(k)) ? 0 : 1;
-  }
-  if (boundaryEdges != ring.size())
-    throw Error(fmt::format("{}: internal error: the mesher changed the outline ({} boundary edges, {} outline "
-                            "points)", where, boundaryEdges, ring.size()));
+  vertices.insert(vertices.end(), inner.begin(), inner.end());
+  triangulatePoints(vertices, ring.size(), where, triangles);
 }
 
 Vec3 place(const PatternPanel& p, const Vec2d& q) {
