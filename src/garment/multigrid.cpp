@@ -187,7 +187,9 @@ void Multigrid::buildProlongation() {
     const Eigen::Matrix3d left = -omega_ * diagInv_[i] * si;
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) {
       const int j = A.col[k];
-      if (agg_[j] >= 0) put(agg_[j], left * A.block[k] * filterMatrix(kind[j], normal_, j));
+      if (agg_[j] < 0) continue;
+      const Eigen::Matrix3d la = left * A.block[k];
+      put(agg_[j], kind[j] == kFreeRow ? la : Eigen::Matrix3d(la * filterMatrix(kind[j], normal_, j)));
     }
   });
   const int m = 1 + *std::max_element(agg_.begin(), agg_.end());
@@ -223,7 +225,7 @@ void Multigrid::buildCoarse(int m) {
     const Eigen::Matrix3d si = filterMatrix((*kind_)[i], normal_, i);
     for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) {
       const int j = A.col[k];
-      const Eigen::Matrix3d sa = si * A.block[k];
+      const Eigen::Matrix3d sa = (*kind_)[i] == kFreeRow ? A.block[k] : Eigen::Matrix3d(si * A.block[k]);
       for (int q = prolong_.start[j]; q < prolong_.start[j + 1]; ++q) put(prolong_.col[q], sa * prolong_.block[q]);
     }
   });
