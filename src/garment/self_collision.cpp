@@ -172,10 +172,6 @@ void forTrianglesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F&
   }
 }
 
-}  // namespace
-
-namespace {
-
 constexpr int64_t kVertexChunk = 256;
 // a pair is kept while its vertex is closer than this many thicknesses to the triangle's plane (or
 // on the other side), its projection less than one thickness fewer outside the triangle: a pair left
@@ -200,8 +196,8 @@ bool projectsNear(const std::array<Vec3, 4>& x1, float near) {
 
 // the step's proximity pairs (vertex, triangle), in vertex order: every free vertex with every
 // triangle whose padded box holds it and that does not hold its seam group, unless it is clear by
-// kNearThicknesses on its side or its projection is one thickness less far outside the triangle. Chunks of vertices in parallel, joined in order: the same pairs for
-// any thread count
+// kNearThicknesses on its side or its projection is one thickness less far outside the triangle.
+// Chunks of vertices in parallel, joined in order: the same pairs for any thread count
 void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int count,
                const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1, float cell, float thickness,
                SelfCollisionScratch& s) {
