@@ -4,11 +4,14 @@
 # joins the two movies with ffmpeg's hstack, each half labelled.
 #
 #   scripts/dry-wet-movie.sh [--work DIR] [--frames N] [--width W] [--height H] DRY.json WET.json OUT.mp4
+#                            [-- RENDER_OPTION...]
 #
-# e.g. scripts/dry-wet-movie.sh scenes/chen_fig9_garment_rain_dry.json \
-#        scenes/chen_fig9_garment_rain_wet.json /tmp/chen_fig9_dry_wet.mp4
+# e.g. (docs/gallery/chen_fig9_dry_wet.mp4) scripts/dry-wet-movie.sh scenes/chen_fig9_garment_rain_dry.json \
+#        scenes/chen_fig9_garment_rain_wet.json docs/gallery/chen_fig9_dry_wet.mp4 \
+#        -- --particles --camera 0.9,1.5,2.0 --look-at 0,1.2,0
 # --work DIR: where the runs and renders go (default /tmp/soak-dry-wet); --frames N: only the first N
-# frames (default: the scenes' own); --width / --height: of each half (default 480 x 360).
+# frames (default: the scenes' own); --width / --height: of each half (default 480 x 360); after --:
+# options for both renders (`soak render`, docs/cli.md), e.g. one camera for both halves.
 # Environment: SOAK (default build/soak), THREADS (default 2).
 # Needs povray and ffmpeg (scripts/setup.sh installs them). The Fig. 9 pair (300 frames each) takes
 # about 15 minutes on 2 cores, most of it POV-Ray.
@@ -21,13 +24,15 @@ width=480
 height=360
 frames=()
 args=()
+render=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --work) work="$2"; shift 2 ;;
     --frames) frames=(--frames "$2"); shift 2 ;;
     --width) width="$2"; shift 2 ;;
     --height) height="$2"; shift 2 ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    --) shift; render=("$@"); break ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     -*) echo "dry-wet-movie.sh: unknown option $1" >&2; exit 1 ;;
     *) args+=("$1"); shift ;;
   esac
@@ -50,7 +55,7 @@ movie() {
   echo "dry-wet-movie: $2: running $1" >&2
   "$soak" run "$1" -o "$work/$2" --threads "$threads" --overwrite --quiet "${frames[@]}"
   echo "dry-wet-movie: $2: rendering" >&2
-  "$soak" render "$work/$2" -o "$work/$2/render" --width "$width" --height "$height" --quiet
+  "$soak" render "$work/$2" -o "$work/$2/render" --width "$width" --height "$height" --quiet "${render[@]}"
 }
 movie "$dry" dry
 movie "$wet" wet
