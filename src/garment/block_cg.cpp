@@ -21,11 +21,7 @@ double orderedSum(const std::vector<double>& terms) {
 
 void BlockMatrix::multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) const {
   y.resize(static_cast<size_t>(rows));
-  parallelFor(rows, [&](int64_t i) {
-    Vec3d sum = Vec3d::Zero();
-    for (int k = rowStart[i]; k < rowStart[i + 1]; ++k) sum += block[k] * x[col[k]];
-    y[i] = sum;
-  });
+  parallelFor(rows, [&](int64_t i) { y[i] = row(x, i); });
 }
 
 double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::vector<double>& partial) {
@@ -92,11 +88,7 @@ CgPreconditioner startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, con
   if (kind == CgPreconditioner::BlockJacobi) invertDiagonal(A, filter, w);
   parallelFor(n, [&](int64_t i) { w.r[i] = filter(i, b[i]); });
   delta0 = precondition(w.r, filter, kind, w, w.s);
-  parallelFor(n, [&](int64_t i) {  // r = filter(b - A x)
-    Vec3d ax = Vec3d::Zero();
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) ax += A.block[k] * x[A.col[k]];
-    w.r[i] = filter(i, b[i] - ax);
-  });
+  parallelFor(n, [&](int64_t i) { w.r[i] = filter(i, b[i] - A.row(x, i)); });  // r = filter(b - A x)
   deltaNew = precondition(w.r, filter, kind, w, w.c);
   return kind;
 }
@@ -127,9 +119,7 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
         w.partial[i] = 0.0;
         return;
       }
-      Vec3d sum = Vec3d::Zero();
-      for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) sum += A.block[k] * w.c[A.col[k]];
-      w.q[i] = filter(i, sum);
+      w.q[i] = filter(i, A.row(w.c, i));
       w.partial[i] = w.c[i].dot(w.q[i]);
     });
     const double cq = orderedSum(w.partial);

@@ -15,6 +15,12 @@ struct BlockMatrix {
   std::vector<int> col;
   std::vector<Eigen::Matrix3d> block;
 
+  // (A x)_i, its blocks summed in column order
+  Vec3d row(const std::vector<Vec3d>& x, int64_t i) const {
+    Vec3d sum = Vec3d::Zero();
+    for (int k = rowStart[i]; k < rowStart[i + 1]; ++k) sum += block[k] * x[col[k]];
+    return sum;
+  }
   // y = A x (gather per row; block_cg.cpp)
   void multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) const;
 };

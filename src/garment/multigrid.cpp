@@ -2,6 +2,7 @@
 #include "garment/multigrid.hpp"
 
 #include "core/parallel.hpp"
+#include "garment/block_cg.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,18 +18,7 @@ constexpr int kPowerIterations = 10;  // for lambda_max(D^-1 A), which sets the 
 void filteredMultiply(const BlockMatrix& A, const std::vector<uint8_t>& kind, std::span<const Vec3d> normal,
                       const std::vector<Vec3d>& x, std::vector<Vec3d>& y) {
   y.resize(x.size());
-  parallelFor(A.rows, [&](int64_t i) {
-    Vec3d sum = Vec3d::Zero();
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) sum += A.block[k] * x[A.col[k]];
-    y[i] = filterRow(kind[i], normal, i, sum);
-  });
-}
-
-// sum of per-row terms in row order: the same for any thread count
-double orderedDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) s += a[i].dot(b[i]);
-  return s;
+  parallelFor(A.rows, [&](int64_t i) { y[i] = filterRow(kind[i], normal, i, A.row(x, i)); });
 }
 
 // rows of blocks built in parallel: unless `samePattern` (out's columns are those of the last build),
@@ -158,7 +148,7 @@ double Multigrid::largestEigenvalue() {
   for (int k = 0; k < kPowerIterations; ++k) {
     filteredMultiply(*fine_, *kind_, normal_, u, tmp_);
     parallelFor(n, [&](int64_t i) { au[i] = diagInv_[i] * tmp_[i]; });
-    const double norm = std::sqrt(orderedDot(au, au)), before = std::sqrt(orderedDot(u, u));
+    const double norm = std::sqrt(blockDot(au, au, partial_)), before = std::sqrt(blockDot(u, u, partial_));
     if (!(norm > 0.0) || !(before > 0.0)) break;
     lambda = norm / before;
     parallelFor(n, [&](int64_t i) { u[i] = au[i] / norm; });
@@ -261,20 +251,14 @@ void Multigrid::buildCoarse(int m) {
 
 void Multigrid::residual(const std::vector<Vec3d>& r) {
   const BlockMatrix& A = *fine_;
-  parallelFor(A.rows, [&](int64_t i) {
-    Vec3d sum = Vec3d::Zero();
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) sum += A.block[k] * x_[A.col[k]];
-    res_[i] = r[i] - filterRow((*kind_)[i], normal_, i, sum);
-  });
+  parallelFor(A.rows, [&](int64_t i) { res_[i] = r[i] - filterRow((*kind_)[i], normal_, i, A.row(x_, i)); });
 }
 
 // x_ += omega D^-1 (r - S A S x_), one pass into tmp_ (every row reads the old x_)
 void Multigrid::jacobiSweep(const std::vector<Vec3d>& r) {
   const BlockMatrix& A = *fine_;
   parallelFor(A.rows, [&](int64_t i) {
-    Vec3d sum = Vec3d::Zero();
-    for (int k = A.rowStart[i]; k < A.rowStart[i + 1]; ++k) sum += A.block[k] * x_[A.col[k]];
-    tmp_[i] = x_[i] + omega_ * (diagInv_[i] * (r[i] - filterRow((*kind_)[i], normal_, i, sum)));
+    tmp_[i] = x_[i] + omega_ * (diagInv_[i] * (r[i] - filterRow((*kind_)[i], normal_, i, A.row(x_, i))));
   });
   std::swap(x_, tmp_);
 }

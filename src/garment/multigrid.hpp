@@ -61,6 +61,7 @@ class Multigrid {
   std::unique_ptr<Ldlt> ldlt_;            // on the heap: Eigen's solvers cannot be moved
   std::vector<Vec3d> x_, res_, tmp_;      // V-cycle work vectors
   Eigen::VectorXd coarseRhs_, coarseX_;
+  std::vector<double> partial_;           // the power iteration's dot products (blockDot)
   ThreadBuffers<int> columnScratch_;       // each thread's column list while rows are built
   std::vector<int> rowStart_, col_;        // A's pattern at the last setup
   bool samePattern_ = false;               // this setup's patterns are the last one's

@@ -47,7 +47,6 @@ bool clearOnItsSide(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1
 
 bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
                            const std::array<float, 4>& w, float d) {
-  if (clearOnItsSide(x0, x1, d)) return false;
   const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
   const float area2 = n1raw.norm();
   if (!(area2 > 1e-12f)) return false;
