@@ -82,23 +82,11 @@ GarmentPiece buildGarmentPiece(const Model& model, int piece, const GarmentParam
     g.col[k++] = v;
     for (int e = sp.vertexStart[v]; e < sp.vertexStart[v + 1]; ++e) g.col[k++] = sp.other(sp.vertexSpring[e], v);
   }
-  std::vector<std::array<int, 3>>& tris = g.triangles;
-  tris.resize(static_cast<size_t>(pc.triangleCount));
+  std::vector<std::array<int, 3>> tris(static_cast<size_t>(pc.triangleCount));
   for (int t = 0; t < pc.triangleCount; ++t)
     for (int k = 0; k < 3; ++k) tris[t][k] = model.triangles[pc.firstTriangle + t][k] - pc.firstParticle;
   g.subdomains = splitIntoPatches(g.count, tris, params.wrinkles.patchSize);
-  // vertices seamed together form one group, named by its lowest vertex (union-find)
-  g.seamGroup.resize(static_cast<size_t>(g.count));
-  for (int v = 0; v < g.count; ++v) g.seamGroup[v] = v;
-  const auto root = [&](int v) {
-    while (g.seamGroup[v] != v) v = g.seamGroup[v] = g.seamGroup[g.seamGroup[v]];
-    return v;
-  };
-  for (const auto& [a, b] : pc.seams) {
-    const int ra = root(a), rb = root(b);
-    g.seamGroup[std::max(ra, rb)] = std::min(ra, rb);
-  }
-  for (int v = 0; v < g.count; ++v) g.seamGroup[v] = root(v);
+  g.mesh = buildSelfCollisionMesh(g.count, std::move(tris), pc.seams);
   return g;
 }
 
@@ -395,15 +383,15 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
 
 // self-collision of the piece (self_collision.hpp), then the vertices it moved are put back out of
 // the colliders (position only, no friction: their contact this step already had it)
-int selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, Particles& p,
-                      ImplicitScratch& w) {
+SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses,
+                                      Particles& p, ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
   w.invMass.resize(static_cast<size_t>(g.count));
   for (int v = 0; v < g.count; ++v)
     w.invMass[v] = (w.constrained[v] == 1 || w.constrained[v] == 2) ? 0.0f : 1.0f / p.mass[first + v];
   const float thickness = model.pieces[static_cast<size_t>(g.piece)].material.thickness;
-  const int pushes = selfCollide(g.triangles, g.seamGroup, g.firstParticle, g.count, w.invMass, thickness, p, w.self);
-  if (pushes == 0) return 0;
+  const SelfCollisionPushes pushes = selfCollide(g.mesh, g.firstParticle, g.count, w.invMass, thickness, p, w.self);
+  if (pushes.vertexTriangle + pushes.edgeEdge == 0) return pushes;
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   for (int v = 0; v < g.count; ++v) {
@@ -447,8 +435,11 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
   integrateWithContact(model, g, params, h, frictionless, poses, saturation, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
-  if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision)
-    stats.selfContacts = selfCollisionStep(model, g, poses, p, w);
+  if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision) {
+    const SelfCollisionPushes pushes = selfCollisionStep(model, g, poses, p, w);
+    stats.selfContacts = pushes.vertexTriangle;
+    stats.selfEdgeContacts = pushes.edgeEdge;
+  }
   for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;
   return stats;
 }

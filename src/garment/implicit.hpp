@@ -47,8 +47,7 @@ struct GarmentPiece {
   // in springs.vertexSpring order
   std::vector<int> rowStart, col;
   std::vector<std::vector<int>> subdomains;  // piece-local vertex sets for the wrinkle model
-  std::vector<std::array<int, 3>> triangles;  // piece-local
-  std::vector<int> seamGroup;                 // per vertex: the lowest vertex it is seamed to (itself if none)
+  SelfCollisionMesh mesh;  // piece-local triangles, edges and seam groups
 };
 
 // builds the garment data of model.pieces[piece]; subdomains are connected patches of
@@ -84,6 +83,7 @@ struct ImplicitStats {
   int contactRows = 0;          // vertices held on a collider by the solve (kContactRow)
   int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider
   int selfContacts = 0;         // vertex-triangle pushes of the self-collision (material.selfCollision)
+  int selfEdgeContacts = 0;     // its edge-edge pushes
   int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)
   float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
 };

@@ -1,10 +1,11 @@
-// vertex-triangle self-collision of implicit garments (self_collision.hpp)
+// vertex-triangle and edge-edge self-collision of implicit garments (self_collision.hpp)
 #include "garment/self_collision.hpp"
 
 #include "core/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace soak {
 
@@ -45,6 +46,73 @@ bool clearOnItsSide(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1
 
 }  // namespace
 
+SelfCollisionMesh buildSelfCollisionMesh(int count, std::vector<std::array<int, 3>> tris,
+                                         const std::vector<std::array<int, 2>>& seams) {
+  SelfCollisionMesh m;
+  m.triangles = std::move(tris);
+  m.group.resize(static_cast<size_t>(count));
+  std::iota(m.group.begin(), m.group.end(), 0);
+  const auto root = [&](int v) {
+    while (m.group[v] != v) v = m.group[v] = m.group[m.group[v]];
+    return v;
+  };
+  for (const auto& [a, b] : seams) {
+    const int ra = root(a), rb = root(b);
+    m.group[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  for (int v = 0; v < count; ++v) m.group[v] = root(v);
+  std::vector<std::array<int, 2>> ringPairs;  // (group, group sharing a triangle with it)
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      m.edges.push_back({std::min(a, b), std::max(a, b)});
+      ringPairs.push_back({m.group[a], m.group[b]});
+      ringPairs.push_back({m.group[b], m.group[a]});
+    }
+  for (auto* v : {&m.edges, &ringPairs}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  m.ringStart.assign(static_cast<size_t>(count) + 1, 0);
+  for (const auto& [g, h] : ringPairs) ++m.ringStart[g + 1];
+  for (int g = 0; g < count; ++g) m.ringStart[g + 1] += m.ringStart[g];
+  for (const auto& pr : ringPairs) m.ring.push_back(pr[1]);
+  return m;
+}
+
+bool SelfCollisionMesh::neighbours(int a, int b) const {
+  return std::binary_search(ring.begin() + ringStart[a], ring.begin() + ringStart[a + 1], b);
+}
+
+namespace {
+
+// moves the four points along the unit n so that n . sum_k a_k x_k grows by `gap`, point k by
+// w_k a_k times a common push (w: inverse masses; momentum is kept), and removes their velocity
+// towards each other, side n . sum_k a_k v_k < 0 (inelastic). False where nothing can move
+bool sharePush(const std::array<float, 4>& a, const Vec3& n, float side, float gap, std::array<Vec3, 4>& x1,
+               std::array<Vec3, 4>& v, const std::array<float, 4>& w) {
+  float denom = 0.0f;
+  for (int k = 0; k < 4; ++k) denom += a[k] * a[k] * w[k];
+  if (!(denom > 0.0f)) return false;
+  const float push = gap / denom;
+  for (int k = 0; k < 4; ++k) x1[k] += w[k] * a[k] * push * n;
+  Vec3 rel = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) rel += a[k] * v[k];
+  const float approach = side * rel.dot(n);
+  if (approach < 0.0f) {
+    const float j = -approach / denom;
+    for (int k = 0; k < 4; ++k) v[k] += w[k] * a[k] * j * side * n;
+  }
+  return true;
+}
+
+// the gap to close, at most kMaxPushes thicknesses a push: a deeper crossing closes over the passes
+// and steps, and no single push stretches the springs around it by more than that (uncapped, the
+// pushes' spring energy fed faster motion and more pushes until the Fig. 9 shirt diverged)
+float cappedGap(float side, float dist, float d) { return std::clamp(side * d - dist, -kMaxPushes * d, kMaxPushes * d); }
+
+}  // namespace
+
 bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
                            const std::array<float, 4>& w, float d) {
   const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
@@ -65,31 +133,66 @@ bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x
   if (side * dist1 >= d) return false;
   // barycentric coordinates of the vertex's projection on the triangle's plane at the end
   const Vec3 q = x1[0] - dist1 * n1;
-  std::array<float, 4> b{};
+  std::array<float, 4> a{1.0f, 0.0f, 0.0f, 0.0f};
   for (int k = 1; k <= 3; ++k) {
     const Vec3& u = x1[k % 3 + 1];
     const Vec3& t = x1[(k + 1) % 3 + 1];
-    b[k] = (u - q).cross(t - q).dot(n1) / area2;
-    if (b[k] < 0.0f) return false;  // outside: the neighbouring triangle's business
+    a[k] = -(u - q).cross(t - q).dot(n1) / area2;
+    if (a[k] > 0.0f) return false;  // outside: the neighbouring triangle's business
   }
-  const float denom = w[0] + b[1] * b[1] * w[1] + b[2] * b[2] * w[2] + b[3] * b[3] * w[3];
-  if (!(denom > 0.0f)) return false;
-  // the gap to close, at most kMaxPushes thicknesses a push: a deeper crossing closes over the passes
-  // and steps, and no single push stretches the springs around it by more than that (uncapped, the
-  // pushes' spring energy fed faster motion and more pushes until the Fig. 9 shirt diverged)
-  const float gap = std::clamp(side * d - dist1, -kMaxPushes * d, kMaxPushes * d);
-  const float push = gap / denom;  // along n1, shared by inverse mass and weight
-  x1[0] += w[0] * push * n1;
-  for (int k = 1; k <= 3; ++k) x1[k] -= b[k] * w[k] * push * n1;
-  Vec3 rel = v[0];
-  for (int k = 1; k <= 3; ++k) rel -= b[k] * v[k];
-  const float approach = side * rel.dot(n1);
-  if (approach < 0.0f) {  // inelastic: the velocity towards each other is removed
-    const float j = -approach / denom;
-    v[0] += w[0] * j * side * n1;
-    for (int k = 1; k <= 3; ++k) v[k] -= b[k] * w[k] * j * side * n1;
-  }
+  // n1 . (x - sum_k b_k x_k) is the vertex's height over the triangle
+  return sharePush(a, n1, side, cappedGap(side, dist1, d), x1, v, w);
+}
+
+namespace {
+
+// the closest points of the lines through edges (p0, p1) and (q0, q1): p0 + s (p1 - p0) and
+// q0 + t (q1 - q0); false where the edges are within about 6 degrees of parallel (their distance is
+// then a vertex's, for the vertex-triangle test)
+bool closestOnLines(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, float& s, float& t) {
+  const Vec3 e1 = p1 - p0, e2 = q1 - q0, r = q0 - p0;
+  const float a = e1.squaredNorm(), b = e1.dot(e2), c = e2.squaredNorm(), f = e1.dot(r), g = e2.dot(r);
+  const float det = a * c - b * b;  // |e1 x e2|^2
+  if (!(det > 0.01f * a * c)) return false;
+  s = (f * c - b * g) / det;
+  t = (b * f - a * g) / det;
   return true;
+}
+
+// whether edges A (x[0], x[1]) and B (x[2], x[3]), from signed distance dist0 at the start to dist1 at
+// the end (opposite signs), passed through each other: at the fraction dist0 / (dist0 - dist1) of the
+// step, the points moving linearly, the lines' closest points lie within both edges (kCrossingSlack
+// of an edge's length beyond its ends). Edges that slid past each other's ends keep their new side
+bool edgesCrossed(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float dist0, float dist1) {
+  const float f = dist0 / (dist0 - dist1);
+  std::array<Vec3, 4> xs;
+  for (int k = 0; k < 4; ++k) xs[k] = x0[k] + f * (x1[k] - x0[k]);
+  float s, t;
+  if (!closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t)) return true;  // parallel at the crossing: keep the start's side
+  const auto within = [](float u) { return u >= -kCrossingSlack && u <= 1.0f + kCrossingSlack; };
+  return within(s) && within(t);
+}
+
+}  // namespace
+
+bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
+                     const std::array<float, 4>& w, float d) {
+  float s, t;
+  // closest points past an end: a vertex's business (vertex-triangle); in one sheet, the lines of two
+  // edges meet outside at least one of them
+  if (!closestOnLines(x1[0], x1[1], x1[2], x1[3], s, t) || s < 0.0f || s > 1.0f || t < 0.0f || t > 1.0f) return false;
+  const Vec3 n1 = (x1[1] - x1[0]).cross(x1[3] - x1[2]).normalized();
+  const Vec3 n0raw = (x0[1] - x0[0]).cross(x0[3] - x0[2]);
+  // edges that turned by more than 60 degrees against each other in one step have no side to compare
+  if (!(n0raw.squaredNorm() > 1e-24f) || n0raw.normalized().dot(n1) < 0.5f) return false;
+  const Vec3 n0 = n0raw.normalized();
+  const float dist0 = (x0[2] - x0[0]).dot(n0), dist1 = (x1[2] - x1[0]).dot(n1);  // B's line over A's
+  float side = std::abs(dist0) > 1e-7f ? (dist0 > 0.0f ? 1.0f : -1.0f) : (dist1 >= 0.0f ? 1.0f : -1.0f);
+  if (side * dist1 < 0.0f && !edgesCrossed(x0, x1, dist0, dist1)) side = -side;
+  if (side * dist1 >= d) return false;
+  // n1 . ((q0 + t e2) - (p0 + s e1)) is B's closest point's height over A's
+  const std::array<float, 4> a{s - 1.0f, -s, 1.0f - t, t};
+  return sharePush(a, n1, side, cappedGap(side, dist1, d), x1, v, w);
 }
 
 namespace {
@@ -102,39 +205,48 @@ uint32_t bucketOf(int64_t i, int64_t j, int64_t k) {
   return static_cast<uint32_t>(h & ((1u << kBucketBits) - 1));
 }
 
-// hashes every triangle into the cells its end-of-step box, padded by `pad`, overlaps (counting sort)
-void hashTriangles(const std::vector<std::array<int, 3>>& tris, const Vec3* x1, float cell, float pad,
-                   SelfCollisionScratch& s) {
-  const size_t nt = tris.size();
-  s.cellLo.resize(nt);
-  s.cellHi.resize(nt);
-  s.boxLo.resize(nt);
-  s.boxHi.resize(nt);
-  s.bucketStart.assign((1u << kBucketBits) + 1, 0);
-  for (size_t t = 0; t < nt; ++t) {
-    Vec3 lo = x1[tris[t][0]], hi = lo;
-    for (int k = 1; k < 3; ++k) {
-      lo = lo.cwiseMin(x1[tris[t][k]]);
-      hi = hi.cwiseMax(x1[tris[t][k]]);
+}  // namespace
+
+template <typename F>
+void BoxGrid::forCells(size_t t, F&& f) const {
+  for (int i = cellLo[t][0]; i <= cellHi[t][0]; ++i)
+    for (int j = cellLo[t][1]; j <= cellHi[t][1]; ++j)
+      for (int k = cellLo[t][2]; k <= cellHi[t][2]; ++k) f(bucketOf(i, j, k));
+}
+
+// hashes every primitive into the cells its end-of-step box, padded by `pad`, overlaps (counting sort)
+template <size_t K>
+void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3* x1, float cellSize, float padding) {
+  const size_t np = prims.size();
+  cell = cellSize;
+  pad = padding;
+  cellLo.resize(np);
+  cellHi.resize(np);
+  boxLo.resize(np);
+  boxHi.resize(np);
+  bucketStart.assign((1u << kBucketBits) + 1, 0);
+  for (size_t t = 0; t < np; ++t) {
+    Vec3 lo = x1[prims[t][0]], hi = lo;
+    for (size_t k = 1; k < K; ++k) {
+      lo = lo.cwiseMin(x1[prims[t][k]]);
+      hi = hi.cwiseMax(x1[prims[t][k]]);
     }
-    s.boxLo[t] = lo - Vec3::Constant(pad);
-    s.boxHi[t] = hi + Vec3::Constant(pad);
+    boxLo[t] = lo - Vec3::Constant(pad);
+    boxHi[t] = hi + Vec3::Constant(pad);
     for (int a = 0; a < 3; ++a) {
-      s.cellLo[t][a] = static_cast<int>(std::floor((lo[a] - pad) / cell));
-      s.cellHi[t][a] = static_cast<int>(std::floor((hi[a] + pad) / cell));
+      cellLo[t][a] = static_cast<int>(std::floor((lo[a] - pad) / cell));
+      cellHi[t][a] = static_cast<int>(std::floor((hi[a] + pad) / cell));
     }
   }
-  const auto forCells = [&](size_t t, auto&& f) {
-    for (int i = s.cellLo[t][0]; i <= s.cellHi[t][0]; ++i)
-      for (int j = s.cellLo[t][1]; j <= s.cellHi[t][1]; ++j)
-        for (int k = s.cellLo[t][2]; k <= s.cellHi[t][2]; ++k) f(bucketOf(i, j, k));
-  };
-  for (size_t t = 0; t < nt; ++t) forCells(t, [&](uint32_t b) { ++s.bucketStart[b + 1]; });
-  for (size_t b = 0; b + 1 < s.bucketStart.size(); ++b) s.bucketStart[b + 1] += s.bucketStart[b];
-  s.entry.resize(s.bucketStart.back());
-  std::vector<uint32_t> fill(s.bucketStart.begin(), s.bucketStart.end() - 1);
-  for (size_t t = 0; t < nt; ++t) forCells(t, [&](uint32_t b) { s.entry[fill[b]++] = static_cast<int>(t); });
+  for (size_t t = 0; t < np; ++t) forCells(t, [&](uint32_t b) { ++bucketStart[b + 1]; });
+  for (size_t b = 0; b + 1 < bucketStart.size(); ++b) bucketStart[b + 1] += bucketStart[b];
+  entry.resize(bucketStart.back());
+  std::vector<uint32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
+  for (size_t t = 0; t < np; ++t)
+    forCells(t, [&](uint32_t b) { entry[fill[b]++] = {static_cast<int>(t), boxLo[t], boxHi[t]}; });
 }
+
+namespace {
 
 // the four particles of one test (ids local to the piece), gathered and written back
 struct Four {
@@ -161,14 +273,42 @@ struct Four {
 
 // calls f(triangle) for every triangle whose padded box holds point q (those hashed into q's cell)
 template <typename F>
-void forTrianglesAt(const Vec3& q, float cell, const SelfCollisionScratch& s, F&& f) {
-  const uint32_t b = bucketOf(static_cast<int>(std::floor(q.x() / cell)), static_cast<int>(std::floor(q.y() / cell)),
-                              static_cast<int>(std::floor(q.z() / cell)));
-  for (uint32_t e = s.bucketStart[b]; e < s.bucketStart[b + 1]; ++e) {
-    const int t = s.entry[e];
-    if ((q.array() < s.boxLo[t].array()).any() || (q.array() > s.boxHi[t].array()).any()) continue;
-    f(t);
+void forTrianglesAt(const Vec3& q, const BoxGrid& g, F&& f) {
+  const uint32_t b = bucketOf(static_cast<int>(std::floor(q.x() / g.cell)), static_cast<int>(std::floor(q.y() / g.cell)),
+                              static_cast<int>(std::floor(q.z() / g.cell)));
+  for (uint32_t e = g.bucketStart[b]; e < g.bucketStart[b + 1]; ++e) {
+    const BoxGrid::Entry& en = g.entry[e];
+    if ((q.array() < en.lo.array()).any() || (q.array() > en.hi.array()).any()) continue;
+    f(en.id);
   }
+}
+
+// calls f(j) once for every edge j after edge i whose padded box overlaps i's own (unpadded) box: j
+// is met in every cell both boxes share, and counted in the first (the lowest in each axis); within a
+// bucket an edge's entries are adjacent (it can land twice in one through two cells)
+template <typename F>
+void forEdgesMeeting(size_t i, const BoxGrid& g, F&& f) {
+  const Vec3 lo = g.boxLo[i] + Vec3::Constant(g.pad), hi = g.boxHi[i] - Vec3::Constant(g.pad);
+  std::array<int, 3> cLo, cHi;
+  for (int a = 0; a < 3; ++a) {
+    cLo[a] = static_cast<int>(std::floor(lo[a] / g.cell));
+    cHi[a] = static_cast<int>(std::floor(hi[a] / g.cell));
+  }
+  for (int ci = cLo[0]; ci <= cHi[0]; ++ci)
+    for (int cj = cLo[1]; cj <= cHi[1]; ++cj)
+      for (int ck = cLo[2]; ck <= cHi[2]; ++ck) {
+        const uint32_t b = bucketOf(ci, cj, ck);
+        const auto begin = g.entry.begin() + g.bucketStart[b], end = g.entry.begin() + g.bucketStart[b + 1];
+        const auto after = std::upper_bound(begin, end, int(i), [](int v, const BoxGrid::Entry& en) { return v < en.id; });
+        for (auto e = after; e != end; ++e) {
+          const int j = e->id;
+          if (e != after && (e - 1)->id == j) continue;
+          if ((hi.array() < e->lo.array()).any() || (lo.array() > e->hi.array()).any()) continue;
+          const auto& jl = g.cellLo[j];
+          if (ci != std::max(cLo[0], jl[0]) || cj != std::max(cLo[1], jl[1]) || ck != std::max(cLo[2], jl[2])) continue;
+          f(j);
+        }
+      }
 }
 
 constexpr int64_t kVertexChunk = 256;
@@ -198,7 +338,7 @@ bool projectsNear(const std::array<Vec3, 4>& x1, float near) {
 // kNearThicknesses on its side or its projection is one thickness less far outside the triangle.
 // Chunks of vertices in parallel, joined in order: the same pairs for any thread count
 void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int count,
-               const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1, float cell, float thickness,
+               const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1, float thickness,
                SelfCollisionScratch& s) {
   const float near = kNearThicknesses * thickness, outside = near - thickness;
   const int64_t chunks = (count + kVertexChunk - 1) / kVertexChunk;
@@ -207,7 +347,7 @@ void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<in
                const int end = static_cast<int>(std::min<int64_t>(count, (c + 1) * kVertexChunk));
                for (int i = static_cast<int>(c * kVertexChunk); i < end; ++i) {
                  if (invMass[i] == 0.0f) continue;
-                 forTrianglesAt(x1[i], cell, s, [&](int t) {
+                 forTrianglesAt(x1[i], s.triangles, [&](int t) {
                    const auto& tri = tris[t];
                    if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
                    const std::array<Vec3, 4> a0{x0[i], x0[tri[0]], x0[tri[1]], x0[tri[2]]};
@@ -220,11 +360,59 @@ void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<in
   for (int64_t c = 0; c < chunks; ++c) s.pairs.insert(s.pairs.end(), s.chunkPairs[c].begin(), s.chunkPairs[c].end());
 }
 
+// whether edges A (x[0], x[1]) and B (x[2], x[3]) are clear by `near` on the side they started on,
+// or their lines' closest points lie more than `outside` beyond an end of either: not within reach
+bool edgesApart(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float near, float outside) {
+  float s, t;
+  if (!closestOnLines(x1[0], x1[1], x1[2], x1[3], s, t)) return true;
+  const float ma = outside / (x1[1] - x1[0]).norm(), mb = outside / (x1[3] - x1[2]).norm();
+  if (s < -ma || s > 1.0f + ma || t < -mb || t > 1.0f + mb) return true;
+  const Vec3 n1 = (x1[1] - x1[0]).cross(x1[3] - x1[2]), n0 = (x0[1] - x0[0]).cross(x0[3] - x0[2]);
+  const float dist1raw = (x1[2] - x1[0]).dot(n1), dist0raw = (x0[2] - x0[0]).dot(n0);
+  return dist0raw * dist1raw > 0.0f && dist1raw * dist1raw >= near * near * n1.squaredNorm();
+}
+
+// the step's edge-edge pairs (A, B), A < B, in A's order: edges with a free vertex, no seam group in
+// common and none sharing a triangle with the other's, B's box padded by `pad` overlapping A's, unless apart (edgesApart, as findPairs). Chunks in
+// parallel, joined in order
+void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1,
+                   float thickness, SelfCollisionScratch& s) {
+  const auto& edges = mesh.edges;
+  const auto& group = mesh.group;
+  const float near = kNearThicknesses * thickness, outside = near - thickness;
+  const int64_t count = static_cast<int64_t>(edges.size()), chunks = (count + kVertexChunk - 1) / kVertexChunk;
+  fillChunks(chunks, s.chunkPairs, omp_get_max_threads(), [] { return 0; },
+             [&](int, int64_t c, std::vector<std::array<int, 2>>& out) {
+               const int64_t end = std::min(count, (c + 1) * kVertexChunk);
+               for (int64_t i = c * kVertexChunk; i < end; ++i) {
+                 const auto& ea = edges[size_t(i)];
+                 const bool free = invMass[ea[0]] > 0.0f || invMass[ea[1]] > 0.0f;
+                 if (!free) continue;
+                 forEdgesMeeting(size_t(i), s.edges, [&](int j) {
+                   const auto& eb = edges[size_t(j)];
+                   const int ga = group[ea[0]], gb = group[ea[1]];
+                   const int gc = group[eb[0]], gd = group[eb[1]];
+                   if (gc == ga || gc == gb || gd == ga || gd == gb) return;
+                   const std::array<Vec3, 4> a0{x0[ea[0]], x0[ea[1]], x0[eb[0]], x0[eb[1]]};
+                   const std::array<Vec3, 4> a1{x1[ea[0]], x1[ea[1]], x1[eb[0]], x1[eb[1]]};
+                   if (edgesApart(a0, a1, near, outside) || mesh.neighbours(ga, gc) || mesh.neighbours(ga, gd) ||
+                       mesh.neighbours(gb, gc) || mesh.neighbours(gb, gd))
+                     return;
+                   out.push_back({int(i), j});
+                 });
+               }
+             });
+  s.edgePairs.clear();
+  for (int64_t c = 0; c < chunks; ++c) s.edgePairs.insert(s.edgePairs.end(), s.chunkPairs[c].begin(), s.chunkPairs[c].end());
+}
+
 }  // namespace
 
-int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int first, int count,
-                const std::vector<float>& invMass, float thickness, Particles& p, SelfCollisionScratch& s) {
-  if (tris.empty() || count == 0) return 0;
+SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass, float thickness,
+                Particles& p, SelfCollisionScratch& s) {
+  const auto& tris = mesh.triangles;
+  const auto& edges = mesh.edges;
+  if (tris.empty() || count == 0) return {};
   const Vec3* x0 = p.x.data() + first;
   Vec3* x1 = p.xPred.data() + first;
   Vec3* vel = p.v.data() + first;
@@ -236,16 +424,26 @@ int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<i
   // motion: a fast garment would make the cells, and every candidate list, as large as the piece
   const float pad = 2.0f * thickness;
   const float cell = std::max(edge / float(tris.size()), 2.0f * pad);
-  hashTriangles(tris, x1, cell, pad, s);
-  findPairs(tris, group, count, invMass, x0, x1, cell, thickness, s);
-  int pushes = 0;
+  s.triangles.build<3>(tris, x1, cell, pad);
+  findPairs(tris, mesh.group, count, invMass, x0, x1, thickness, s);
+  // the edges' boxes padded by one thickness only, in cells of two mean edges (about two cells an
+  // axis a box): a pair coming within reach through the passes' pushes waits for the next step
+  s.edges.build<2>(edges, x1, 2.0f * edge / float(tris.size()), thickness);
+  findEdgePairs(mesh, invMass, x0, x1, thickness, s);
+  SelfCollisionPushes pushes;
   for (int pass = 0; pass < kPasses; ++pass) {
     for (const auto& [i, t] : s.pairs) {
       const auto& tri = tris[t];
       Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
       if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) continue;
       f.store(x1, vel, s.moved);
-      ++pushes;
+      ++pushes.vertexTriangle;
+    }
+    for (const auto& [a, b] : s.edgePairs) {
+      Four f({edges[a][0], edges[a][1], edges[b][0], edges[b][1]}, x0, x1, vel, invMass);
+      if (!pushEdgeOffEdge(f.x0, f.x1, f.v, f.w, thickness)) continue;
+      f.store(x1, vel, s.moved);
+      ++pushes.edgeEdge;
     }
   }
   return pushes;

@@ -1,15 +1,14 @@
 // self-collision of an implicit garment (docs/garment.md, "Self-collision"): after the solve and the
 // body contact, every free vertex is kept at least the cloth's thickness away from every triangle of
-// its piece that does not hold it (or a vertex seamed to it), on the side it was at the start of the
-// step, so a vertex that passed through a triangle during the step is put back (proximity with the
-// start-of-step side, after Bridson, Fedkiw and Anderson 2002); one that crossed the plane outside
-// the triangle (round its edge) keeps its new side, and a push closes at most one thickness. Edge-edge proximity is not tested:
-// two edges can still pass through each other between the vertices. The push is shared by the vertex and
-// the triangle's three vertices by inverse mass and barycentric weight (momentum is kept), and their
-// velocity towards each other along the triangle's normal is removed (inelastic). The pairs within
-// reach (closer than 2 d to the plane, projecting less than d outside the triangle) are found once
-// per step, by chunks of vertices in parallel joined in order; the passes are Gauss-Seidel over those
-// pairs in vertex order, serial: the result does not depend on the thread count.
+// its piece that does not hold it (or a vertex seamed to it), and every mesh edge as far from every
+// edge it does not share a vertex (or seam group) with, on the side it was at the start of the step,
+// so a vertex or edge that passed through during the step is put back (proximity with the
+// start-of-step side, after Bridson, Fedkiw and Anderson 2002); one that went round the triangle's
+// or the edge's end keeps its new side, and a push closes at most one thickness. The push is shared
+// by the four points by inverse mass and barycentric weight (momentum is kept), and their velocity
+// towards each other along the normal is removed (inelastic). The pairs within reach are found once
+// per step, by chunks in parallel joined in order; the passes are Gauss-Seidel over those pairs,
+// vertex-triangle then edge-edge, serial: the result does not depend on the thread count.
 #pragma once
 #include <soak/math.hpp>
 #include <soak/model.hpp>
@@ -17,17 +16,50 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace soak {
 
+// the constant data of one piece's self-collision (piece-local vertex ids)
+struct SelfCollisionMesh {
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<std::array<int, 2>> edges;  // every triangle side once, (a < b), ascending
+  std::vector<int> group;                 // per vertex: the lowest vertex it is seamed to (itself if none)
+  // per group g: the groups sharing a triangle with it, ring[ringStart[g] .. ringStart[g + 1]), ascending
+  std::vector<int> ringStart, ring;
+  // whether groups a and b share a triangle (a vertex of one lies in the other's one-ring)
+  bool neighbours(int a, int b) const;
+};
+
+// the self-collision data of a piece of `count` vertices with triangles `tris` and seams (pairs of
+// vertices sewn together, joined into groups by union-find)
+SelfCollisionMesh buildSelfCollisionMesh(int count, std::vector<std::array<int, 3>> tris,
+                                         const std::vector<std::array<int, 2>>& seams);
+
+// a hashed grid of the padded end-of-step boxes of a piece's triangles or edges
+struct BoxGrid {
+  float cell = 1.0f;                  // m
+  float pad = 0.0f;                   // m
+  struct Entry {
+    int id;
+    Vec3 lo, hi;  // its padded box, kept beside the id for the bucket's scan
+  };
+  std::vector<uint32_t> bucketStart;  // primitives of hash bucket b: entry[bucketStart[b] .. bucketStart[b + 1]), ascending
+  std::vector<Entry> entry;
+  std::vector<std::array<int, 3>> cellLo, cellHi;  // each primitive's cell range
+  std::vector<Vec3> boxLo, boxHi;                  // each primitive's padded box
+  template <size_t K>
+  void build(std::span<const std::array<int, K>> prims, const Vec3* x1, float cellSize, float padding);
+  template <typename F>
+  void forCells(size_t t, F&& f) const;  // f(bucket) for every cell of primitive t
+};
+
 struct SelfCollisionScratch {
-  std::vector<uint32_t> bucketStart;  // triangles of hash bucket b: entry[bucketStart[b] .. bucketStart[b + 1])
-  std::vector<int> entry;
-  std::vector<std::array<int, 3>> cellLo, cellHi;  // each triangle's cell range
-  std::vector<Vec3> boxLo, boxHi;                  // each triangle's padded box
-  std::vector<std::array<int, 2>> pairs;            // the step's proximity pairs (vertex, triangle)
-  std::vector<std::vector<std::array<int, 2>>> chunkPairs;  // per chunk of vertices, joined into pairs
+  BoxGrid triangles, edges;
+  std::vector<std::array<int, 2>> pairs;      // the step's proximity pairs (vertex, triangle)
+  std::vector<std::array<int, 2>> edgePairs;  // and (edge, edge), A < B
+  std::vector<std::vector<std::array<int, 2>>> chunkPairs;  // per chunk of vertices or edges, joined into pairs
   std::vector<uint8_t> moved;                      // per vertex of the piece: pushed this step
 };
 
@@ -38,11 +70,24 @@ struct SelfCollisionScratch {
 bool pushVertexOffTriangle(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
                            const std::array<float, 4>& w, float d);
 
-// three Gauss-Seidel passes over the piece's particles [first, first + count): every vertex against the local
-// triangles `tris` within its reach. Seam groups `group` (vertices seamed together share a group): a triangle holding
-// the vertex's group is not tested. Inverse masses `invMass` (0: pinned or disturbed). Positions p.x (start) and p.xPred (end),
-// velocities p.v. Marks the vertices it moved in s.moved. Returns the pushes made.
-int selfCollide(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int first, int count, const std::vector<float>& invMass,
-                float thickness, Particles& p, SelfCollisionScratch& s);
+// the push of edge A (points 0, 1) against edge B (points 2, 3), as pushVertexOffTriangle: their
+// lines' closest points, inside both edges at the end, are kept d apart along the edges' common
+// normal, on the side B started on (or its new side where the edges slid past each other's ends).
+// Returns false when they are clear, their closest points lie past an end (a vertex's case), the
+// edges are within about 6 degrees of parallel, or they turned by more than 60 degrees in the step
+bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
+                     const std::array<float, 4>& w, float d);
+
+// three Gauss-Seidel passes over the piece's particles [first, first + count): every vertex against the triangles
+// within its reach, then every edge against the edges within its reach. A triangle holding the vertex's seam group
+// is not tested, nor an edge pair that shares a group or whose groups share a triangle (two sides of one fold:
+// a crossing between them is a vertex's through a triangle). Inverse masses `invMass` (0: pinned or disturbed).
+// Positions p.x (start) and p.xPred (end), velocities p.v. Marks the vertices it moved in s.moved. Returns the
+// pushes made of each kind.
+struct SelfCollisionPushes {
+  int vertexTriangle = 0, edgeEdge = 0;
+};
+SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass, float thickness,
+                Particles& p, SelfCollisionScratch& s);
 
 }  // namespace soak

@@ -212,6 +212,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.contactRows += static_cast<uint64_t>(r.contactRows);
     gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
     gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
+    gs.selfEdgeContacts += static_cast<uint64_t>(r.selfEdgeContacts);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
   }
   if (!model.hasImplicitCloth()) return;

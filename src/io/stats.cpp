@@ -90,6 +90,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"contactRows", g.contactRows},
                     {"edgeContacts", g.edgeContacts},
                     {"selfContacts", g.selfContacts},
+                    {"selfEdgeContacts", g.selfEdgeContacts},
                     {"disturbances", g.disturbances},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},

@@ -1,5 +1,6 @@
-// vertex-triangle self-collision of implicit garments (garment/self_collision.hpp)
+// vertex-triangle and edge-edge self-collision of implicit garments (garment/self_collision.hpp)
 #include "garment/self_collision.hpp"
+#include "support/mesh_crossings.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -96,10 +97,9 @@ TEST(GarmentSelfCollision, ASheetDroppedOnAnotherStaysOnIt) {
   p.xPred = p.x;
   for (int i = 4; i < 8; ++i) p.xPred[i].z() = -0.005f;
   const std::vector<std::array<int, 3>> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
-  const std::vector<int> group = {0, 1, 2, 3, 4, 5, 6, 7};
   const std::vector<float> inv(8, 1.0f);
   SelfCollisionScratch s;
-  EXPECT_GT(selfCollide(tris, group, 0, 8, inv, 0.008f, p, s), 0);
+  EXPECT_GT(selfCollide(buildSelfCollisionMesh(8, tris, {}), 0, 8, inv, 0.008f, p, s).vertexTriangle, 0);
   for (int i = 4; i < 8; ++i)  // every upper vertex over the lower sheet is back above it
     if (p.xPred[i].x() < 1.0f && p.xPred[i].y() < 1.0f) EXPECT_GT(p.xPred[i].z(), 0.0f) << i;
 }
@@ -127,24 +127,119 @@ TEST(GarmentSelfCollision, SameResultForAnyThreadCount) {
   const int n = 2 * kSide * kSide;
   start.xPred = start.x;
   for (int i = kSide * kSide; i < n; ++i) start.xPred[i].z() -= 0.02f;  // 8 mm through the lower sheet
-  std::vector<int> group(n);
-  std::iota(group.begin(), group.end(), 0);
+  const SelfCollisionMesh mesh = buildSelfCollisionMesh(n, tris, {});
   const std::vector<float> inv(n, 1.0f);
   auto run = [&](int threads) {
     const int before = omp_get_max_threads();
     omp_set_num_threads(threads);
     Particles p = start;
     SelfCollisionScratch s;
-    const int pushes = selfCollide(tris, group, 0, n, inv, 0.008f, p, s);
+    const SelfCollisionPushes pushes = selfCollide(mesh, 0, n, inv, 0.008f, p, s);
     omp_set_num_threads(before);
     return std::pair{pushes, p};
   };
   const auto [pushes1, a] = run(1);
   const auto [pushes2, b] = run(2);
-  EXPECT_GT(pushes1, kSide * kSide);  // every upper vertex over the lower sheet, at least once
-  EXPECT_EQ(pushes1, pushes2);
+  EXPECT_GT(pushes1.vertexTriangle, kSide * kSide);  // every upper vertex over the lower sheet, at least once
+  EXPECT_GT(pushes1.edgeEdge, 0);
+  EXPECT_EQ(pushes1.vertexTriangle, pushes2.vertexTriangle);
+  EXPECT_EQ(pushes1.edgeEdge, pushes2.edgeEdge);
   EXPECT_EQ(std::memcmp(a.xPred.data(), b.xPred.data(), n * sizeof(Vec3)), 0);
   EXPECT_EQ(std::memcmp(a.v.data(), b.v.data(), n * sizeof(Vec3)), 0);
+}
+
+// a 3 x 2 grid (0 1 2 / 3 4 5) whose right column is seamed to a second quad's left (6 7 / 8 9)
+TEST(GarmentSelfCollision, TheMeshJoinsSeamedVerticesAndKnowsTheirNeighbours) {
+  const std::vector<std::array<int, 3>> tris = {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}, {6, 7, 9}, {6, 9, 8}};
+  const SelfCollisionMesh m = buildSelfCollisionMesh(10, tris, {{2, 6}, {8, 5}});
+  EXPECT_EQ(m.edges.size(), 9u + 5u);
+  EXPECT_TRUE(std::is_sorted(m.edges.begin(), m.edges.end()));
+  EXPECT_EQ(m.group, (std::vector<int>{0, 1, 2, 3, 4, 5, 2, 7, 5, 9}));
+  EXPECT_TRUE(m.neighbours(0, 4));   // across the diagonal
+  EXPECT_FALSE(m.neighbours(0, 5));  // two triangles apart
+  EXPECT_TRUE(m.neighbours(1, 2));
+  EXPECT_TRUE(m.neighbours(2, 7));   // through the seam: 6 is 2's group
+  EXPECT_TRUE(m.neighbours(2, 9));   // 6 shares (6, 9, 8) with 9
+  EXPECT_TRUE(m.neighbours(9, 5));   // 8 is 5's group
+  EXPECT_FALSE(m.neighbours(7, 5));  // 7's one triangle is (6, 7, 9)
+  EXPECT_FALSE(m.neighbours(1, 7));
+}
+
+// edge A along x in z = 0, edge B along y at height z over its middle (points A0, A1, B0, B1)
+std::array<Vec3, 4> edgesCrossingAt(float z, float bx = 0.0f) {
+  return {Vec3(-0.5f, 0, 0), Vec3(0.5f, 0, 0), Vec3(bx, -0.5f, z), Vec3(bx, 0.5f, z)};
+}
+// the height of B's middle over A's point under it, at the fraction s along A
+float bOverA(const std::array<Vec3, 4>& x, float s = 0.5f) {
+  return 0.5f * (x[2].z() + x[3].z()) - ((1.0f - s) * x[0].z() + s * x[1].z());
+}
+
+TEST(GarmentSelfCollision, AnEdgeThatPassedThroughAnEdgeIsPutBack) {
+  std::array<Vec3, 4> x1 = edgesCrossingAt(-0.003f);
+  std::array<Vec3, 4> v{Vec3::Zero(), Vec3::Zero(), Vec3(0, 0, -1), Vec3(0, 0, -1)};
+  const std::array<float, 4> w{1, 1, 1, 1};
+  ASSERT_TRUE(pushEdgeOffEdge(edgesCrossingAt(0.01f), x1, v, w, 0.008f));
+  EXPECT_NEAR(bOverA(x1), 0.005f, 1e-6f);  // back over A by one thickness of the 1.1 cm gap
+  EXPECT_NEAR(x1[0].z() + x1[1].z() + x1[2].z() + x1[3].z(), -0.006f, 1e-6f);  // equal masses: momentum kept
+  EXPECT_NEAR(v[2].z() - v[0].z(), 0.0f, 1e-6f);                           // no longer approaching
+  EXPECT_NEAR(v[0].z() + v[1].z() + v[2].z() + v[3].z(), -2.0f, 1e-6f);
+  ASSERT_TRUE(pushEdgeOffEdge(edgesCrossingAt(0.01f), x1, v, w, 0.008f));
+  EXPECT_NEAR(bOverA(x1), 0.008f, 1e-6f);
+  EXPECT_FALSE(pushEdgeOffEdge(edgesCrossingAt(0.01f), x1, v, w, 0.008f));  // clear now
+  std::array<Vec3, 4> pinnedA = edgesCrossingAt(0.002f);  // only B moves: all of the push is B's
+  ASSERT_TRUE(pushEdgeOffEdge(edgesCrossingAt(0.01f), pinnedA, v, {0, 0, 1, 1}, 0.008f));
+  EXPECT_NEAR(pinnedA[2].z(), 0.008f, 1e-6f);
+  EXPECT_EQ(pinnedA[0].z(), 0.0f);
+}
+
+TEST(GarmentSelfCollision, EdgesPastEachOthersEndsParallelOrInOneSheetAreLeftAlone) {
+  std::array<Vec3, 4> v{};
+  const std::array<float, 4> w{1, 1, 1, 1};
+  std::array<Vec3, 4> beyond = edgesCrossingAt(0.002f, 0.6f);  // B over the line of A, past its end
+  EXPECT_FALSE(pushEdgeOffEdge(beyond, beyond, v, w, 0.008f));
+  std::array<Vec3, 4> parallel = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0.001f, 0.002f), Vec3(1, 0.001f, 0.002f)};
+  EXPECT_FALSE(pushEdgeOffEdge(parallel, parallel, v, w, 0.008f));
+  // two edges of one flat sheet: their lines meet outside them
+  std::array<Vec3, 4> sheet = {Vec3(0, 0, 0), Vec3(0.02f, 0, 0), Vec3(0.02f, 0.02f, 0), Vec3(0.04f, 0.04f, 0)};
+  EXPECT_FALSE(pushEdgeOffEdge(sheet, sheet, v, w, 0.008f));
+  std::array<Vec3, 4> near = edgesCrossingAt(0.002f);
+  EXPECT_FALSE(pushEdgeOffEdge(edgesCrossingAt(0.01f), near, v, {0, 0, 0, 0}, 0.008f));  // nothing may move
+  // B slid down past A's end (x from 1.5 to 0.4: it crossed A's line at x = 0.65, beyond A's end at 0.5)
+  // and under it: it keeps its new side, pushed to a thickness below
+  std::array<Vec3, 4> under = edgesCrossingAt(-0.003f, 0.4f);
+  ASSERT_TRUE(pushEdgeOffEdge(edgesCrossingAt(0.01f, 1.5f), under, v, w, 0.008f));
+  EXPECT_NEAR(bOverA(under, 0.9f), -0.008f, 1e-6f);
+}
+
+// two 2 cm wide strips of one piece at right angles, 1 cm apart; the upper (along y) tilts, one end
+// 2 cm down, through the lower (along x): no vertex of either lies over the other's triangles, only
+// their edges cross
+TEST(GarmentSelfCollision, StripsCrossingOnlyAtTheirEdgesAreKeptApart) {
+  Particles start;
+  for (float y : {-0.01f, 0.01f})
+    for (float x : {-0.5f, 0.5f}) start.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0), Vec3::Zero());
+  for (float y : {-0.5f, 0.5f})
+    for (float x : {-0.01f, 0.01f}) start.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0.01f), Vec3(0, 0, -1));
+  start.xPred = start.x;
+  for (int i = 4; i < 6; ++i) start.xPred[i].z() -= 0.02f;  // the end at y = -0.5
+  const std::vector<std::array<int, 3>> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
+  const SelfCollisionMesh mesh = buildSelfCollisionMesh(8, tris, {});
+  const std::vector<float> inv(8, 1.0f);
+  const auto crossings = [&](const Particles& p) { return testing::countCrossingTriangles(p.xPred, tris); };
+  ASSERT_GT(crossings(start), 0u);
+  SelfCollisionScratch s;
+  Particles vertexOnly = start;
+  SelfCollisionMesh noEdges = mesh;
+  noEdges.edges.clear();
+  EXPECT_EQ(selfCollide(noEdges, 0, 8, inv, 0.008f, vertexOnly, s).vertexTriangle, 0);  // no vertex over a triangle
+  EXPECT_GT(crossings(vertexOnly), 0u);
+  Particles p = start;
+  const SelfCollisionPushes pushes = selfCollide(mesh, 0, 8, inv, 0.008f, p, s);
+  EXPECT_EQ(pushes.vertexTriangle, 0);
+  EXPECT_GT(pushes.edgeEdge, 0);
+  EXPECT_EQ(crossings(p), 0u);
+  const auto middleHeight = [&](int a, int b) { return 0.5f * (p.xPred[a].z() + p.xPred[b].z()); };
+  EXPECT_GT(middleHeight(4, 7), middleHeight(0, 3));  // the upper strip's middle is back over the lower's
 }
 
 }  // namespace

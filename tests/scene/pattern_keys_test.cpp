@@ -93,17 +93,16 @@ TEST_P(ShippedGarments, SewShutOnTheBodyAndStayOn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedGarments,
-                         // the T-shirt's underarm seams fold through themselves: 2 pairs of its 1,270
-                         // triangles with the vertex-triangle self-collision (14 without; edges still
-                         // pass through edges); the dress and the skirt have none
-                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72, 4},
+                         // none of the three has triangles through each other (measured); the 4 cm
+                         // T-shirt's layers do not meet in its first second, the dress's do (90 pushes)
+                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72, 0},
                                            ShippedGarment{"garment_dress_rain.json", 0.45, 0},
                                            ShippedGarment{"garment_skirt.json", 0.44, 0}));
 
 // the shipped moving-body scene (scenes/garment_tshirt_moving.json, without its rain), the shirt at
 // 4 cm: the mannequin raises its arms to 70 degrees (1.5 s to 3 s) and lowers them (to 4.5 s). Every
 // solve converges, no vertex ends inside the moving body, the shirt rides up with the arms and comes
-// back down, and few of its triangles pass through each other
+// back down, and none of its triangles passes through another
 TEST(PatternScene, TheShirtFollowsTheMovingBody) {
   Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/garment_tshirt_moving.json",
                       {"cloth.0.mesh.edgeLength=0.04", "emitters=[]"});
@@ -129,15 +128,16 @@ TEST(PatternScene, TheShirtFollowsTheMovingBody) {
   const auto [after, deepAfter, crossAfter] = look();
   EXPECT_EQ(total.garment.unconverged, 0u);
   EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
+  EXPECT_GT(total.garment.selfEdgeContacts, 0u) << "a weak case: no edges met";  // measured 79
   const float margin = 0.5f * piece.material.thickness - 5e-4f;  // measured at the margin, 0.5 thickness
   EXPECT_GT(deepBefore, margin);
   EXPECT_GT(deepRaised, margin);
   EXPECT_GT(deepAfter, margin);
   EXPECT_GT(raised, before + 0.05);  // measured 1.166 m, 1.255 m and 1.214 m mean height
   EXPECT_LT(after, raised - 0.02);
-  EXPECT_LE(crossBefore, 2u);  // measured none at each
-  EXPECT_LE(crossRaised, 2u);
-  EXPECT_LE(crossAfter, 2u);
+  EXPECT_EQ(crossBefore, 0u);  // measured none at each
+  EXPECT_EQ(crossRaised, 0u);
+  EXPECT_EQ(crossAfter, 0u);
 }
 
 // the counter the garment test uses: a triangle pierced by another counts, one touching it through a
