@@ -40,8 +40,7 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   m.damping = r.number("damping", d.damping, Range::nonNegative());
   m.thickness = r.number("thickness", d.thickness, Range::positive());
   readFriction(r, d.friction, m.friction, m.staticFriction);
-  // on by default for PBD pieces; an implicit piece's (garment/self_collision.hpp) is asked for
-  m.selfCollision = r.boolean("selfCollision", solver == ClothSolver::Pbd && d.selfCollision);
+  m.selfCollision = r.boolean("selfCollision", d.selfCollision);
   m.tetherSlack = r.number("tetherSlack", d.tetherSlack, Range::nonNegative());
   r.finish();
   return m;

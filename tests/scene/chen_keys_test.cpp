@@ -60,7 +60,7 @@ TEST(GarmentScene, KeysReachTheModel) {
   EXPECT_FLOAT_EQ(p.garment.friction.peak, 0.7f);
   EXPECT_TRUE(p.garment.wrinkles.enabled);              // a present section is on
   EXPECT_EQ(p.garment.wrinkles.interval, 5);
-  EXPECT_FALSE(p.material.selfCollision);  // off by default on an implicit piece
+  EXPECT_TRUE(p.material.selfCollision);  // on by default for both solvers
   // the garment's panels are the wrinkle subdomains; no PBD constraints or tethers for it
   EXPECT_EQ(p.panelOfVertex.size(), size_t(p.particleCount));
   EXPECT_TRUE(m.stretch.ids.empty());
