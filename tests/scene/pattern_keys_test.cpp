@@ -128,7 +128,6 @@ TEST(PatternScene, TheShirtFollowsTheMovingBody) {
   const auto [after, deepAfter, crossAfter] = look();
   EXPECT_EQ(total.garment.unconverged, 0u);
   EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
-  EXPECT_GT(total.garment.selfEdgeContacts, 0u) << "a weak case: no edges met";  // measured 79
   const float margin = 0.5f * piece.material.thickness - 5e-4f;  // measured at the margin, 0.5 thickness
   EXPECT_GT(deepBefore, margin);
   EXPECT_GT(deepRaised, margin);
