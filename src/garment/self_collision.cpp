@@ -109,7 +109,9 @@ bool sharePush(const std::array<float, 4>& a, const Vec3& n, float side, float g
 // the gap to close, at most kMaxPushes thicknesses a push: a deeper crossing closes over the passes
 // and steps, and no single push stretches the springs around it by more than that (uncapped, the
 // pushes' spring energy fed faster motion and more pushes until the Fig. 9 shirt diverged)
-float cappedGap(float side, float dist, float d) { return std::clamp(side * d - dist, -kMaxPushes * d, kMaxPushes * d); }
+float cappedGap(float side, float dist, float d) {
+  return std::clamp(side * d - dist, -kMaxPushes * d, kMaxPushes * d);
+}
 
 }  // namespace
 
@@ -168,7 +170,7 @@ bool edgesCrossed(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, 
   std::array<Vec3, 4> xs;
   for (int k = 0; k < 4; ++k) xs[k] = x0[k] + f * (x1[k] - x0[k]);
   float s, t;
-  if (!closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t)) return true;  // parallel at the crossing: keep the start's side
+  if (!closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t)) return true;  // parallel then: keep the start's side
   const auto within = [](float u) { return u >= -kCrossingSlack && u <= 1.0f + kCrossingSlack; };
   return within(s) && within(t);
 }
@@ -299,7 +301,8 @@ void forEdgesMeeting(size_t i, const BoxGrid& g, F&& f) {
       for (int ck = cLo[2]; ck <= cHi[2]; ++ck) {
         const uint32_t b = bucketOf(ci, cj, ck);
         const auto begin = g.entry.begin() + g.bucketStart[b], end = g.entry.begin() + g.bucketStart[b + 1];
-        const auto after = std::upper_bound(begin, end, int(i), [](int v, const BoxGrid::Entry& en) { return v < en.id; });
+        const auto after =
+            std::upper_bound(begin, end, int(i), [](int v, const BoxGrid::Entry& en) { return v < en.id; });
         for (auto e = after; e != end; ++e) {
           const int j = e->id;
           if (e != after && (e - 1)->id == j) continue;
@@ -311,7 +314,7 @@ void forEdgesMeeting(size_t i, const BoxGrid& g, F&& f) {
       }
 }
 
-constexpr int64_t kVertexChunk = 256;
+constexpr int64_t kChunk = 256;  // vertices or edges a chunk of the parallel pair search
 // a pair is kept while its vertex is closer than this many thicknesses to the triangle's plane (or
 // on the other side), its projection less than one thickness fewer outside the triangle: a pair left
 // out needs more than a thickness of motion (a push's most) to come within reach of the push
@@ -341,11 +344,11 @@ void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<in
                const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1, float thickness,
                SelfCollisionScratch& s) {
   const float near = kNearThicknesses * thickness, outside = near - thickness;
-  const int64_t chunks = (count + kVertexChunk - 1) / kVertexChunk;
+  const int64_t chunks = (count + kChunk - 1) / kChunk;
   fillChunks(chunks, s.chunkPairs, omp_get_max_threads(), [] { return 0; },
              [&](int, int64_t c, std::vector<std::array<int, 2>>& out) {
-               const int end = static_cast<int>(std::min<int64_t>(count, (c + 1) * kVertexChunk));
-               for (int i = static_cast<int>(c * kVertexChunk); i < end; ++i) {
+               const int end = static_cast<int>(std::min<int64_t>(count, (c + 1) * kChunk));
+               for (int i = static_cast<int>(c * kChunk); i < end; ++i) {
                  if (invMass[i] == 0.0f) continue;
                  forTrianglesAt(x1[i], s.triangles, [&](int t) {
                    const auto& tri = tris[t];
@@ -373,18 +376,18 @@ bool edgesApart(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, fl
 }
 
 // the step's edge-edge pairs (A, B), A < B, in A's order: edges with a free vertex, no seam group in
-// common and none sharing a triangle with the other's, B's box padded by `pad` overlapping A's, unless apart (edgesApart, as findPairs). Chunks in
-// parallel, joined in order
+// common and none sharing a triangle with the other's, B's padded box overlapping A's box, unless
+// apart (edgesApart, as findPairs). Chunks in parallel, joined in order
 void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1,
                    float thickness, SelfCollisionScratch& s) {
   const auto& edges = mesh.edges;
   const auto& group = mesh.group;
   const float near = kNearThicknesses * thickness, outside = near - thickness;
-  const int64_t count = static_cast<int64_t>(edges.size()), chunks = (count + kVertexChunk - 1) / kVertexChunk;
+  const int64_t count = static_cast<int64_t>(edges.size()), chunks = (count + kChunk - 1) / kChunk;
   fillChunks(chunks, s.chunkPairs, omp_get_max_threads(), [] { return 0; },
              [&](int, int64_t c, std::vector<std::array<int, 2>>& out) {
-               const int64_t end = std::min(count, (c + 1) * kVertexChunk);
-               for (int64_t i = c * kVertexChunk; i < end; ++i) {
+               const int64_t end = std::min(count, (c + 1) * kChunk);
+               for (int64_t i = c * kChunk; i < end; ++i) {
                  const auto& ea = edges[size_t(i)];
                  const bool free = invMass[ea[0]] > 0.0f || invMass[ea[1]] > 0.0f;
                  if (!free) continue;
@@ -403,13 +406,14 @@ void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invM
                }
              });
   s.edgePairs.clear();
-  for (int64_t c = 0; c < chunks; ++c) s.edgePairs.insert(s.edgePairs.end(), s.chunkPairs[c].begin(), s.chunkPairs[c].end());
+  for (int64_t c = 0; c < chunks; ++c)
+    s.edgePairs.insert(s.edgePairs.end(), s.chunkPairs[c].begin(), s.chunkPairs[c].end());
 }
 
 }  // namespace
 
-SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass, float thickness,
-                Particles& p, SelfCollisionScratch& s) {
+SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass,
+                                float thickness, Particles& p, SelfCollisionScratch& s) {
   const auto& tris = mesh.triangles;
   const auto& edges = mesh.edges;
   if (tris.empty() || count == 0) return {};

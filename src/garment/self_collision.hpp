@@ -45,7 +45,8 @@ struct BoxGrid {
     int id;
     Vec3 lo, hi;  // its padded box, kept beside the id for the bucket's scan
   };
-  std::vector<uint32_t> bucketStart;  // primitives of hash bucket b: entry[bucketStart[b] .. bucketStart[b + 1]), ascending
+  // primitives of hash bucket b: entry[bucketStart[b] .. bucketStart[b + 1]), ascending
+  std::vector<uint32_t> bucketStart;
   std::vector<Entry> entry;
   std::vector<std::array<int, 3>> cellLo, cellHi;  // each primitive's cell range
   std::vector<Vec3> boxLo, boxHi;                  // each primitive's padded box
@@ -87,7 +88,7 @@ bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std
 struct SelfCollisionPushes {
   int vertexTriangle = 0, edgeEdge = 0;
 };
-SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass, float thickness,
-                Particles& p, SelfCollisionScratch& s);
+SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass,
+                                float thickness, Particles& p, SelfCollisionScratch& s);
 
 }  // namespace soak
