@@ -2,6 +2,7 @@
 #include "garment/self_collision.hpp"
 
 #include "core/parallel.hpp"
+#include "world/mesh.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -61,18 +62,15 @@ SelfCollisionMesh buildSelfCollisionMesh(int count, std::vector<std::array<int, 
     m.group[std::max(ra, rb)] = std::min(ra, rb);
   }
   for (int v = 0; v < count; ++v) m.group[v] = root(v);
-  std::vector<std::array<int, 2>> ringPairs;  // (group, group sharing a triangle with it)
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      m.edges.push_back({std::min(a, b), std::max(a, b)});
-      ringPairs.push_back({m.group[a], m.group[b]});
-      ringPairs.push_back({m.group[b], m.group[a]});
-    }
-  for (auto* v : {&m.edges, &ringPairs}) {
-    std::sort(v->begin(), v->end());
-    v->erase(std::unique(v->begin(), v->end()), v->end());
+  std::vector<std::array<int, 2>> ringPairs;  // (group, group sharing a triangle with it): an edge's ends
+  for (const EdgeRef& e : collectEdges(m.triangles)) {  // sorted by (lo, hi)
+    if (!m.edges.empty() && m.edges.back() == std::array<int, 2>{e.lo, e.hi}) continue;
+    m.edges.push_back({e.lo, e.hi});
+    ringPairs.push_back({m.group[e.lo], m.group[e.hi]});
+    ringPairs.push_back({m.group[e.hi], m.group[e.lo]});
   }
+  std::sort(ringPairs.begin(), ringPairs.end());
+  ringPairs.erase(std::unique(ringPairs.begin(), ringPairs.end()), ringPairs.end());
   m.ringStart.assign(static_cast<size_t>(count) + 1, 0);
   for (const auto& [g, h] : ringPairs) ++m.ringStart[g + 1];
   for (int g = 0; g < count; ++g) m.ringStart[g + 1] += m.ringStart[g];
@@ -391,9 +389,9 @@ void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invM
                  const auto& ea = edges[size_t(i)];
                  const bool free = invMass[ea[0]] > 0.0f || invMass[ea[1]] > 0.0f;
                  if (!free) continue;
+                 const int ga = group[ea[0]], gb = group[ea[1]];
                  forEdgesMeeting(size_t(i), s.edges, [&](int j) {
                    const auto& eb = edges[size_t(j)];
-                   const int ga = group[ea[0]], gb = group[ea[1]];
                    const int gc = group[eb[0]], gd = group[eb[1]];
                    if (gc == ga || gc == gb || gd == ga || gd == gb) return;
                    const std::array<Vec3, 4> a0{x0[ea[0]], x0[ea[1]], x0[eb[0]], x0[eb[1]]};
