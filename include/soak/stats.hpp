@@ -43,6 +43,7 @@ struct GarmentStats {
   uint64_t factorFailures = 0;  // solves whose Cholesky or multigrid factor failed (block Jacobi used)
   uint64_t contacts = 0;        // vertex-collider contacts
   uint64_t contactRows = 0;     // of them, vertices held on a collider by the solve (contact rows)
+  uint64_t stickingRows = 0;    // of those, sticking to it (static friction); the others slide
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)
   uint64_t selfContacts = 0;    // vertex-triangle pushes of an implicit piece's self-collision
   uint64_t selfEdgeContacts = 0;  // and its edge-edge pushes
@@ -51,7 +52,7 @@ struct GarmentStats {
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     return *this;
   }
 };

@@ -28,7 +28,9 @@ struct BlockMatrix {
 // the filter S_i of row i (Baraff & Witkin's constraint filter), from its kind: kFreeRow: I;
 // kContactRow: I - n n^T with n the row's unit contact normal; any other value: 0 (the row is held)
 constexpr uint8_t kFreeRow = 0;
-constexpr uint8_t kContactRow = 4;
+constexpr uint8_t kContactRow = 4;  // on a collider, sliding: its normal velocity prescribed
+constexpr uint8_t kStickRow = 5;    // on a collider, sticking: held (its whole velocity prescribed)
+inline bool isContactRow(uint8_t kind) { return kind == kContactRow || kind == kStickRow; }
 inline Vec3d filterRow(uint8_t kind, std::span<const Vec3d> normal, size_t i, const Vec3d& a) {
   if (kind == kFreeRow) return a;
   if (kind == kContactRow) return a - normal[i].dot(a) * normal[i];

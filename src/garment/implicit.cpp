@@ -189,14 +189,16 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
 constexpr float kContactBand = 1.25f;
 
 void contactRows(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, const Particles& p,
-                 float h, ImplicitScratch& w, ImplicitStats& stats) {
+                 float h, std::span<const float> fabricFriction, ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
   const float band = kContactBand * margin;
   w.contactNormal.resize(static_cast<size_t>(g.count));
   w.contactVelocity.resize(static_cast<size_t>(g.count));
-  w.contactImpulse.resize(static_cast<size_t>(g.count));
+  w.contactMu.resize(static_cast<size_t>(g.count));
+  w.startVelocity.resize(static_cast<size_t>(g.count));
+  w.frictionImpulse.assign(static_cast<size_t>(g.count), Vec3d::Zero());
   w.contactCollider.assign(static_cast<size_t>(g.count), -1);
   parallelFor(numColliders ? g.count : 0, [&](int64_t v) {
     if (w.constrained[v] != kFreeRow) return;
@@ -224,12 +226,21 @@ void contactRows(const Model& model, const GarmentPiece& g, const std::vector<Co
       w.contactCollider[v] = -1;
       return;
     }
-    w.constrained[v] = kContactRow;
     w.contactNormal[v] = n;
     w.contactVelocity[v] = vCol;
-    w.dv[v] = (vn - v0.dot(n)) * n + (w.dv[v] - w.dv[v].dot(n) * n);  // prescribed normal, guessed tangential part
+    w.startVelocity[v] = v0;
+    const Collider& collider = model.colliders[static_cast<size_t>(w.contactCollider[v])];
+    const float fabric = fabricFriction[static_cast<size_t>(v)];
+    w.contactMu[v] = {mixFriction(fabric, collider.staticFriction), mixFriction(fabric, collider.friction)};
+    if (w.contactMu[v].staticCoef > 0.0f || w.contactMu[v].kinetic > 0.0f) {  // sticks first: moves with the surface
+      const Vec3d vc = vCol.cast<double>();
+      w.constrained[v] = kStickRow;
+      w.dv[v] = vn * n + (vc - vc.dot(n) * n) - v0;
+    } else {  // frictionless: slides with the prescribed normal velocity, the tangential part guessed
+      w.constrained[v] = kContactRow;
+      w.dv[v] = (vn - v0.dot(n)) * n + (w.dv[v] - w.dv[v].dot(n) * n);
+    }
   });
-  for (int v = 0; v < g.count; ++v) stats.contactRows += w.constrained[v] == kContactRow ? 1 : 0;
 }
 
 // (A dv - b) of row v: the impulse the row's constraint applies (zero on a free row)
@@ -253,18 +264,64 @@ void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm
   vel = vCol + after;
 }
 
-// the filtered PCG of Eq. 5 with the contact rows, each row's impulse n . (A dv - b) after it to
-// w.contactImpulse; a contact row whose constraint pulled the vertex
-// into the collider (a negative impulse: its neighbours lift it off) is released and the system
-// solved again from the last solution (Baraff & Witkin 1998 release a constraint by its force's
-// sign), at most kReleaseRounds times
-constexpr int kReleaseRounds = 2;
+// Coulomb friction inside the solve, as an active set over the contact rows (Baraff & Witkin 1998
+// section 5.3 release a row by the sign of its force; friction applied after the solve moved held
+// vertices back against neighbours the solve had let them drag: docs/garment.md departure 10). After
+// a solve each row's constraint impulse r = A dv - b (b holding a sliding row's friction) is split
+// into its support N = n . r and its tangential part T:
+//   N < 0 (the row pulls the vertex into the collider): released, a free vertex;
+//   sticking, |T| > mu_s N: it slides, with the kinetic impulse mu_k N T/|T| added to its b;
+//   sliding, its slip after the solve along its friction (friction reversed the slip): it sticks;
+//   sliding otherwise: its friction impulse follows the new support, mu_k N.
+// impulseChange receives each row's change of friction impulse; returns whether a row changed kind.
+bool updateContactRows(ImplicitScratch& w, std::vector<Vec3d>& impulseChange) {
+  bool changed = false;
+  for (int v = 0; v < w.A.rows; ++v) {
+    impulseChange[v].setZero();
+    if (!isContactRow(w.constrained[v])) continue;
+    const Vec3d n = w.contactNormal[v];
+    const Vec3d r = rowResidual(w.A, w.dv, w.rhs, v);  // a sliding row: its friction is in w.rhs, r is normal
+    const double support = n.dot(r);
+    Vec3d friction = Vec3d::Zero();
+    if (support < 0.0) {
+      w.constrained[v] = kFreeRow;
+      w.contactCollider[v] = -1;
+      changed = true;
+    } else if (w.constrained[v] == kStickRow) {
+      const Vec3d t = r - support * n;
+      const double limit = std::max(w.contactMu[v].staticCoef, w.contactMu[v].kinetic) * support;
+      if (t.norm() > limit) {
+        w.constrained[v] = kContactRow;
+        friction = (w.contactMu[v].kinetic * support / t.norm()) * t;
+        changed = true;
+      }
+    } else if (w.contactMu[v].kinetic > 0.0f) {
+      const Vec3d vc = w.contactVelocity[v].cast<double>();
+      const Vec3d v1 = w.startVelocity[v] + w.dv[v];
+      const Vec3d along = w.frictionImpulse[v].normalized();
+      if (w.frictionImpulse[v].squaredNorm() > 0.0 && (v1 - vc).dot(along) > 0.0) {
+        w.constrained[v] = kStickRow;
+        w.dv[v] = v1.dot(n) * n + (vc - vc.dot(n) * n) - w.startVelocity[v];
+        changed = true;
+      } else {
+        friction = w.contactMu[v].kinetic * support * along;
+      }
+    }
+    impulseChange[v] = friction - w.frictionImpulse[v];
+  }
+  return changed;
+}
+
+// the filtered PCG of Eq. 5 with the contact rows, solved again from the last solution while
+// updateContactRows changes a row's kind, at most kContactRounds more times
+constexpr int kContactRounds = 3;
 
 void solveWithContact(const GarmentParams& params, ImplicitScratch& w, ImplicitStats& stats) {
   CgOptions opt;
   opt.tolerance = params.cgTolerance;
   opt.maxIterations = params.cgMaxIterations;
   opt.preconditioner = params.cgPreconditioner;
+  w.frictionChange.resize(static_cast<size_t>(w.A.rows));
   for (int round = 0;; ++round) {
     const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg, w.contactNormal);
     stats.cgIterations += cg.iterations;
@@ -272,26 +329,23 @@ void solveWithContact(const GarmentParams& params, ImplicitScratch& w, ImplicitS
     stats.converged = cg.converged;
     stats.breakdown = stats.breakdown || cg.breakdown;
     stats.factorFailed = stats.factorFailed || cg.factorFailed;
-    for (int v = 0; v < w.A.rows; ++v)
-      if (w.constrained[v] == kContactRow) w.contactImpulse[v] = w.contactNormal[v].dot(rowResidual(w.A, w.dv, w.rhs, v));
-    if (round == kReleaseRounds) return;
-    int released = 0;
+    if (round == kContactRounds || !updateContactRows(w, w.frictionChange)) break;
     for (int v = 0; v < w.A.rows; ++v) {
-      if (w.constrained[v] != kContactRow || w.contactImpulse[v] >= 0.0) continue;
-      w.constrained[v] = kFreeRow;
-      w.contactCollider[v] = -1;
-      ++released;
+      w.rhs[v] += w.frictionChange[v];
+      w.frictionImpulse[v] += w.frictionChange[v];
     }
-    stats.contactRows -= released;
-    if (released == 0) return;
+  }
+  for (int v = 0; v < w.A.rows; ++v) {
+    stats.contactRows += isContactRow(w.constrained[v]) ? 1 : 0;
+    stats.stickingRows += w.constrained[v] == kStickRow ? 1 : 0;
   }
 }
 
-// v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then contact with the colliders at time + h, with
-// the fabric's wet friction (none if `frictionless`: a sewn garment settling); marks the vertices in
-// contact with 3 in w.constrained
-void integrateWithContact(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
-                          bool frictionless, const std::vector<ColliderPose>& poses, std::span<const float> saturation,
+// v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then a vertex that ends within the margin of a
+// collider is put back out to it, with the fabric's wet friction (w.fabricMu) against any collider but
+// its contact row's (whose friction was in the solve); marks the vertices in contact with 3 in
+// w.constrained
+void integrateWithContact(const Model& model, const GarmentPiece& g, float h, const std::vector<ColliderPose>& poses,
                           Particles& p, ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
@@ -310,18 +364,8 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, const Garme
       p.xPred[i] = x;
       return;
     }
-    const float muFabric =
-        frictionless ? 0.0f : wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
-    const int held = w.constrained[v] == kContactRow ? w.contactCollider[v] : -1;
-    if (held >= 0) {  // friction with the impulse the contact row applied (its normal velocity is the solve's)
-      const Vec3 n = w.contactNormal[v].cast<float>();
-      const float impulse = static_cast<float>(w.contactImpulse[v]);
-      const Vec3 rel = vel - w.contactVelocity[v];
-      const Vec3 after = coulombFriction(rel, n, mixFriction(muFabric, model.colliders[held].friction),
-                                         impulse / p.mass[i]);
-      x += h * (after - rel);
-      vel = w.contactVelocity[v] + after;
-    }
+    const float muFabric = w.fabricMu[static_cast<size_t>(v)];
+    const int held = isContactRow(w.constrained[v]) ? w.contactCollider[v] : -1;  // friction was in the solve
     bool contact = held >= 0;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm, vCol;
@@ -429,11 +473,14 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   for (int v = 0; warm && v < g.count; ++v)  // the free rows start from the last step's dv (warm start)
     if (w.constrained[v] == kFreeRow) w.dv[v] = velocityChange[v].cast<double>();
   assembleSystem(model, g, params, p, hd, sewing && !params.seams.gravityWhileClosing ? 0.0 : 1.0, w);
-  contactRows(model, g, poses, p, h, w, stats);
+  w.fabricMu.assign(static_cast<size_t>(g.count), 0.0f);
+  for (int v = 0; !frictionless && v < g.count; ++v)
+    w.fabricMu[v] = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
+  contactRows(model, g, poses, p, h, w.fabricMu, w);
   solveWithContact(params, w, stats);
   if (velocityChange.size() == static_cast<size_t>(g.count))
     for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
-  integrateWithContact(model, g, params, h, frictionless, poses, saturation, p, w);
+  integrateWithContact(model, g, h, poses, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision) {
     const SelfCollisionPushes pushes = selfCollisionStep(model, g, poses, p, w);

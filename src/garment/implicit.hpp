@@ -20,6 +20,7 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
+#include "core/friction.hpp"
 #include "garment/block_cg.hpp"
 #include "garment/saturation_mass.hpp"
 #include "garment/self_collision.hpp"
@@ -61,10 +62,15 @@ struct ImplicitScratch {
   std::vector<Eigen::Matrix3d> springStiffness;
   std::vector<float> strain;
   std::vector<Vec3d> rhs, dv;
-  std::vector<uint8_t> constrained;     // per vertex: 0 free, 1 pinned, 2 disturbed, kContactRow; 3 after the step: in contact
+  // per vertex: 0 free, 1 pinned, 2 disturbed, kContactRow (sliding), kStickRow; 3 after the step: in contact
+  std::vector<uint8_t> constrained;
   std::vector<Vec3d> contactNormal;     // per contact row: the collider's unit normal
   std::vector<Vec3> contactVelocity;    // per contact row: the collider's surface velocity (m/s)
-  std::vector<double> contactImpulse;   // per contact row: n . (A dv - b) after the solve (kg m/s)
+  std::vector<float> fabricMu;          // per vertex: the fabric's friction at its saturation (0 while sewing)
+  std::vector<FrictionCoefficients> contactMu;  // per contact row: the fabric's (wet) friction mixed with the collider's
+  std::vector<Vec3d> startVelocity;     // per contact row: v0 (m/s)
+  std::vector<Vec3d> frictionImpulse;   // per vertex: a sliding row's kinetic friction on the right-hand side (kg m/s)
+  std::vector<Vec3d> frictionChange;    // updateContactRows' change of frictionImpulse
   std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
@@ -80,7 +86,8 @@ struct ImplicitStats {
   bool factorFailed = false; // the Cholesky or multigrid coarse factor failed: block Jacobi was used
   int constrainedVertices = 0;  // pinned + disturbed
   int contacts = 0;             // vertices held on (contact rows) or pushed out of a collider
-  int contactRows = 0;          // vertices held on a collider by the solve (kContactRow)
+  int contactRows = 0;          // vertices held on a collider by the solve (kContactRow, kStickRow)
+  int stickingRows = 0;         // of them, sticking to it (static friction)
   int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider
   int selfContacts = 0;         // vertex-triangle pushes of the self-collision (material.selfCollision)
   int selfEdgeContacts = 0;     // its edge-edge pushes

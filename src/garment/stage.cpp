@@ -210,6 +210,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.factorFailures += r.factorFailed ? 1 : 0;
     gs.contacts += static_cast<uint64_t>(r.contacts);
     gs.contactRows += static_cast<uint64_t>(r.contactRows);
+    gs.stickingRows += static_cast<uint64_t>(r.stickingRows);
     gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
     gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
     gs.selfEdgeContacts += static_cast<uint64_t>(r.selfEdgeContacts);

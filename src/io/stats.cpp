@@ -88,6 +88,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"factorFailures", g.factorFailures},
                     {"contacts", g.contacts},
                     {"contactRows", g.contactRows},
+                    {"stickingRows", g.stickingRows},
                     {"edgeContacts", g.edgeContacts},
                     {"selfContacts", g.selfContacts},
                     {"selfEdgeContacts", g.selfEdgeContacts},

@@ -58,6 +58,7 @@ struct ShippedGarment {
   double lowest;  // m, the lowest point after 1 s stays above this (measured 3 to 4 cm above; falling off
                   // would take it 1 m lower)
   size_t crossings;  // triangle pairs through each other after 1 s, at most
+  bool layersMeet;   // its self-collision pushes vertices off its triangles in that second
 };
 
 class ShippedGarments : public ::testing::TestWithParam<ShippedGarment> {};
@@ -90,19 +91,22 @@ TEST_P(ShippedGarments, SewShutOnTheBodyAndStayOn) {
   EXPECT_EQ(total.garment.unconverged, 0u);
   const std::vector<Vec3> cloth(x.begin(), x.begin() + m.numCloth);
   EXPECT_LE(testing::countCrossingTriangles(cloth, m.triangles, piece.seams), GetParam().crossings);
+  if (GetParam().layersMeet) EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
 }
 
 INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedGarments,
                          // none of the three has triangles through each other (measured); the 4 cm
-                         // T-shirt's layers do not meet in its first second, the dress's do (90 pushes)
-                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72, 0},
-                                           ShippedGarment{"garment_dress_rain.json", 0.45, 0},
-                                           ShippedGarment{"garment_skirt.json", 0.44, 0}));
+                         // T-shirt's and skirt's layers do not meet in their first second, the dress's
+                         // do (94 pushes)
+                         ::testing::Values(ShippedGarment{"chen_fig9_garment_rain_dry.json", 0.72, 0, false},
+                                           ShippedGarment{"garment_dress_rain.json", 0.45, 0, true},
+                                           ShippedGarment{"garment_skirt.json", 0.44, 0, false}));
 
 // the shipped moving-body scene (scenes/garment_tshirt_moving.json, without its rain), the shirt at
 // 4 cm: the mannequin raises its arms to 70 degrees (1.5 s to 3 s) and lowers them (to 4.5 s). Every
 // solve converges, no vertex ends inside the moving body, the shirt rides up with the arms and comes
-// back down, and none of its triangles passes through another
+// back down, and none of its triangles passes through another (at 4 cm its layers do not meet; the
+// dress above has the self-collision pushes)
 TEST(PatternScene, TheShirtFollowsTheMovingBody) {
   Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/garment_tshirt_moving.json",
                       {"cloth.0.mesh.edgeLength=0.04", "emitters=[]"});
@@ -127,12 +131,11 @@ TEST(PatternScene, TheShirtFollowsTheMovingBody) {
   testing::run(m, s.state, 90, &total);  // 4.5 s: arms down again
   const auto [after, deepAfter, crossAfter] = look();
   EXPECT_EQ(total.garment.unconverged, 0u);
-  EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
   const float margin = 0.5f * piece.material.thickness - 5e-4f;  // measured at the margin, 0.5 thickness
   EXPECT_GT(deepBefore, margin);
   EXPECT_GT(deepRaised, margin);
   EXPECT_GT(deepAfter, margin);
-  EXPECT_GT(raised, before + 0.05);  // measured 1.166 m, 1.255 m and 1.214 m mean height
+  EXPECT_GT(raised, before + 0.05);  // measured 1.166 m, 1.230 m and 1.176 m mean height
   EXPECT_LT(after, raised - 0.02);
   EXPECT_EQ(crossBefore, 0u);  // measured none at each
   EXPECT_EQ(crossRaised, 0u);
