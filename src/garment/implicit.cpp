@@ -366,6 +366,15 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, float h, co
     }
     const float muFabric = w.fabricMu[static_cast<size_t>(v)];
     const int held = isContactRow(w.constrained[v]) ? w.contactCollider[v] : -1;  // friction was in the solve
+    if (held >= 0 && w.frictionImpulse[v].squaredNorm() > 0.0) {  // sliding: friction never reverses the slip
+      const Vec3 n = w.contactNormal[v].cast<float>(), along = w.frictionImpulse[v].normalized().cast<float>();
+      const Vec3 rel = vel - w.contactVelocity[v];
+      if (rel.dot(along) > 0.0f) {  // the last round's friction overshot: the vertex stops on the surface
+        const Vec3 stopped = rel.dot(n) * n;
+        x += h * (stopped - rel);
+        vel = w.contactVelocity[v] + stopped;
+      }
+    }
     bool contact = held >= 0;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm, vCol;
