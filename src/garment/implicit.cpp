@@ -181,11 +181,13 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
 // contact as a constraint of the solve (Baraff & Witkin 1998 section 5.3; Chen 2012 leaves contact to
 // after the solve: docs/garment.md departure 10): a free vertex within kContactBand margins of a
 // collider at the start of the step, which its own row's estimate v0 + A_ii^-1 b_i would take nearer
-// than the margin, gets a contact row (kContactRow): its velocity along the nearest collider's normal
-// after the step is prescribed, so that it comes down to the margin and never leaves the surface
-// faster than the surface moves; it slides freely, and friction acts after the solve with the row's
-// impulse (integrateWithContact). A vertex whose estimate leaves is not held: no glue. The solve's
-// neighbours of a held vertex see it held, where a push after the solve would stretch their springs.
+// than the margin, gets a contact row: its velocity along the nearest collider's normal after the
+// step is prescribed, so that it comes down to the margin and never leaves the surface faster than
+// the surface moves. With friction it starts sticking (kStickRow: its tangential velocity the
+// surface's), without it slides (kContactRow); updateContactRows then applies Coulomb's law. A vertex
+// whose estimate leaves is not held: no glue. The solve's neighbours of a held vertex see it held,
+// where a push after the solve would stretch their springs. fabricFriction: the fabric's coefficient
+// per vertex, mixed with the collider's static and kinetic ones.
 constexpr float kContactBand = 1.25f;
 
 void contactRows(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, const Particles& p,
