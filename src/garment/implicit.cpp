@@ -190,6 +190,13 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
 // per vertex, mixed with the collider's static and kinetic ones.
 constexpr float kContactBand = 1.25f;
 
+// the velocity after the step of a vertex sticking to a surface moving at vCol: the surface's along
+// the tangent plane, normalSpeed along the unit normal n
+Vec3d stickingVelocity(const Vec3d& n, double normalSpeed, const Vec3& vCol) {
+  const Vec3d vc = vCol.cast<double>();
+  return normalSpeed * n + (vc - vc.dot(n) * n);
+}
+
 void contactRows(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, const Particles& p,
                  float h, std::span<const float> fabricFriction, ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
@@ -199,7 +206,6 @@ void contactRows(const Model& model, const GarmentPiece& g, const std::vector<Co
   w.contactNormal.resize(static_cast<size_t>(g.count));
   w.contactVelocity.resize(static_cast<size_t>(g.count));
   w.contactMu.resize(static_cast<size_t>(g.count));
-  w.startVelocity.resize(static_cast<size_t>(g.count));
   w.frictionImpulse.assign(static_cast<size_t>(g.count), Vec3d::Zero());
   w.contactCollider.assign(static_cast<size_t>(g.count), -1);
   parallelFor(numColliders ? g.count : 0, [&](int64_t v) {
@@ -230,14 +236,12 @@ void contactRows(const Model& model, const GarmentPiece& g, const std::vector<Co
     }
     w.contactNormal[v] = n;
     w.contactVelocity[v] = vCol;
-    w.startVelocity[v] = v0;
     const Collider& collider = model.colliders[static_cast<size_t>(w.contactCollider[v])];
     const float fabric = fabricFriction[static_cast<size_t>(v)];
     w.contactMu[v] = {mixFriction(fabric, collider.staticFriction), mixFriction(fabric, collider.friction)};
     if (w.contactMu[v].staticCoef > 0.0f || w.contactMu[v].kinetic > 0.0f) {  // sticks first: moves with the surface
-      const Vec3d vc = vCol.cast<double>();
       w.constrained[v] = kStickRow;
-      w.dv[v] = vn * n + (vc - vc.dot(n) * n) - v0;
+      w.dv[v] = stickingVelocity(n, vn, vCol) - v0;
     } else {  // frictionless: slides with the prescribed normal velocity, the tangential part guessed
       w.constrained[v] = kContactRow;
       w.dv[v] = (vn - v0.dot(n)) * n + (w.dv[v] - w.dv[v].dot(n) * n);
@@ -275,8 +279,9 @@ void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm
 //   sticking, |T| > mu_s N: it slides, with the kinetic impulse mu_k N T/|T| added to its b;
 //   sliding, its slip after the solve along its friction (friction reversed the slip): it sticks;
 //   sliding otherwise: its friction impulse follows the new support, mu_k N.
-// impulseChange receives each row's change of friction impulse; returns whether a row changed kind.
-bool updateContactRows(ImplicitScratch& w, std::vector<Vec3d>& impulseChange) {
+// v0: the piece's velocities at the start of the step; impulseChange receives each row's change of
+// friction impulse. Returns whether a row changed kind.
+bool updateContactRows(std::span<const Vec3> v0, ImplicitScratch& w, std::vector<Vec3d>& impulseChange) {
   bool changed = false;
   for (int v = 0; v < w.A.rows; ++v) {
     impulseChange[v].setZero();
@@ -298,12 +303,11 @@ bool updateContactRows(ImplicitScratch& w, std::vector<Vec3d>& impulseChange) {
         changed = true;
       }
     } else if (w.contactMu[v].kinetic > 0.0f) {
-      const Vec3d vc = w.contactVelocity[v].cast<double>();
-      const Vec3d v1 = w.startVelocity[v] + w.dv[v];
+      const Vec3d start = v0[static_cast<size_t>(v)].cast<double>(), v1 = start + w.dv[v];
       const Vec3d along = w.frictionImpulse[v].normalized();
-      if (w.frictionImpulse[v].squaredNorm() > 0.0 && (v1 - vc).dot(along) > 0.0) {
+      if (w.frictionImpulse[v].squaredNorm() > 0.0 && (v1 - w.contactVelocity[v].cast<double>()).dot(along) > 0.0) {
         w.constrained[v] = kStickRow;
-        w.dv[v] = v1.dot(n) * n + (vc - vc.dot(n) * n) - w.startVelocity[v];
+        w.dv[v] = stickingVelocity(n, v1.dot(n), w.contactVelocity[v]) - start;
         changed = true;
       } else {
         friction = w.contactMu[v].kinetic * support * along;
@@ -318,7 +322,7 @@ bool updateContactRows(ImplicitScratch& w, std::vector<Vec3d>& impulseChange) {
 // updateContactRows changes a row's kind, at most kContactRounds more times
 constexpr int kContactRounds = 3;
 
-void solveWithContact(const GarmentParams& params, ImplicitScratch& w, ImplicitStats& stats) {
+void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, ImplicitScratch& w, ImplicitStats& stats) {
   CgOptions opt;
   opt.tolerance = params.cgTolerance;
   opt.maxIterations = params.cgMaxIterations;
@@ -331,7 +335,7 @@ void solveWithContact(const GarmentParams& params, ImplicitScratch& w, ImplicitS
     stats.converged = cg.converged;
     stats.breakdown = stats.breakdown || cg.breakdown;
     stats.factorFailed = stats.factorFailed || cg.factorFailed;
-    if (round == kContactRounds || !updateContactRows(w, w.frictionChange)) break;
+    if (round == kContactRounds || !updateContactRows(v0, w, w.frictionChange)) break;
     for (int v = 0; v < w.A.rows; ++v) {
       w.rhs[v] += w.frictionChange[v];
       w.frictionImpulse[v] += w.frictionChange[v];
@@ -488,7 +492,8 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   for (int v = 0; !frictionless && v < g.count; ++v)
     w.fabricMu[v] = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
   contactRows(model, g, poses, p, h, w.fabricMu, w);
-  solveWithContact(params, w, stats);
+  const std::span<const Vec3> v0(p.v.data() + g.firstParticle, static_cast<size_t>(g.count));
+  solveWithContact(params, v0, w, stats);
   if (velocityChange.size() == static_cast<size_t>(g.count))
     for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
   integrateWithContact(model, g, h, poses, p, w);

@@ -68,7 +68,6 @@ struct ImplicitScratch {
   std::vector<Vec3> contactVelocity;    // per contact row: the collider's surface velocity (m/s)
   std::vector<float> fabricMu;          // per vertex: the fabric's friction at its saturation (0 while sewing)
   std::vector<FrictionCoefficients> contactMu;  // per contact row: the fabric's friction mixed with the collider's
-  std::vector<Vec3d> startVelocity;     // per contact row: v0 (m/s)
   std::vector<Vec3d> frictionImpulse;   // per vertex: a sliding row's kinetic friction on the right-hand side (kg m/s)
   std::vector<Vec3d> frictionChange;    // updateContactRows' change of frictionImpulse
   std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none

@@ -264,7 +264,7 @@ TEST(GarmentImplicit, WetFrictionHoldsClothThatSlidesWhenDry) {
   EXPECT_LT(std::abs(slide(true)), 1e-5f);
 }
 
-// Coulomb friction in the solve (docs/garment.md "Body contact"): on a 20 degree slope a sheet with
+// Coulomb friction in the solve (docs/garment.md departure 9): on a 20 degree slope a sheet with
 // mixed friction 0.3 slides at g (sin 20 - 0.3 cos 20), backward Euler's a h^2 N (N + 1) / 2 after N
 // steps, and one with 0.4 holds (tan 20 = 0.364); the same at the loose default tolerance, solved
 // exactly, and at half the step
