@@ -331,11 +331,12 @@ void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, Imp
   opt.maxIterations = params.cgMaxIterations;
   opt.preconditioner = params.cgPreconditioner;
   w.frictionChange.resize(static_cast<size_t>(w.A.rows));
+  const double tolerance = params.cgTolerance;
+  const double roundTolerance = std::max(tolerance, std::min(tolerance * kRoundLoosening, kRoundTolerance));
   bool settled = std::none_of(w.constrained.begin(), w.constrained.end(), isContactRow);  // no row to change
   for (int round = 0;; ++round) {
     const bool last = settled || round == kContactRounds;
-    const double tolerance = params.cgTolerance;
-    opt.tolerance = last ? tolerance : std::max(tolerance, std::min(tolerance * kRoundLoosening, kRoundTolerance));
+    opt.tolerance = last ? tolerance : roundTolerance;
     const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg, w.contactNormal);
     stats.cgIterations += cg.iterations;
     stats.cgResidual = cg.residual;
@@ -344,7 +345,7 @@ void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, Imp
     stats.factorFailed = stats.factorFailed || cg.factorFailed;
     if (last) break;
     settled = !updateContactRows(v0, w, w.frictionChange);
-    for (int v = 0; v < w.A.rows; ++v) {  // a sliding row's friction follows its new support
+    for (int v = 0; v < w.A.rows; ++v) {  // the new friction: a row that began to slide, or one whose support changed
       w.rhs[v] += w.frictionChange[v];
       w.frictionImpulse[v] += w.frictionChange[v];
     }

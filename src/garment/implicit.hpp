@@ -3,9 +3,10 @@
 //   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),   v1 = v0 + dv,   x1 = x0 + h v1,
 // with the KES springs of springs.hpp, gravity, Rayleigh damping D = alpha M + beta K (Eq. 22-24),
 // the saturation mass of Eq. 15-19 (read from Particles::mass), pinned vertices and temporary
-// position constraints (wrinkles.hpp) and the contact of vertices resting on a collider enforced by the
-// filtered PCG of block_cg.hpp, and, after the solve, friction with the wet friction curve of Fig. 5
-// (wet_friction.hpp) and contact of the vertices that reached a collider during the step.
+// position constraints (wrinkles.hpp) and the contact of vertices resting on a collider, with Coulomb
+// friction at the wet friction curve of Fig. 5 (wet_friction.hpp), enforced by the filtered PCG of
+// block_cg.hpp; after the solve, contact and friction of the vertices that reached a collider during
+// the step.
 //
 // Use from the step, for a piece whose scene says "solver": "implicit" (docs/garment.md): one call
 //   ImplicitStats s = garmentSubstep(model, g, params, saturation, h, time, stepIndex, poses, p, scratch);
