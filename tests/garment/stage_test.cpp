@@ -426,8 +426,8 @@ TEST(GarmentRun, WetSilkOnTheBallHangsLowerThanDry) {
     EXPECT_NEAR(wet.state.particles.mass[size_t(i)], 3e-5 * (1.0 + 0.84), 1e-9);
   const double yDry = garmentShape(dry.model, dry.state).meanHeight, yWet = garmentShape(wet.model, wet.state).meanHeight;
   EXPECT_LT(yWet, yDry - 0.002) << "dry " << yDry << " wet " << yWet;
-  // the contact rounds settle which rows stick before the last solve: the exact solve drapes the
-  // wet silk the same (with three rounds at the full tolerance they differed by 0.9 mm)
+  // the contact rounds settle which rows stick before the last solve, so the exact solve drapes the
+  // wet silk the same (docs/garment.md, "The Fig. 8 silk drapes the same for any solve")
   std::vector<std::string> exactSet = wetSet;
   exactSet.insert(exactSet.end(), {"cloth.0.garment.cg.preconditioner=cholesky", "cloth.0.garment.cg.tolerance=1e-8"});
   Scene exact = loadScene(dir + "chen_fig8_silk_sphere_wet.json", exactSet);

@@ -97,7 +97,7 @@ TEST_P(ShippedGarments, SewShutOnTheBodyAndStayOn) {
 }
 
 INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedGarments,
-                         // none of the three has triangles through each other (measured); the 4 cm
+                         // none has triangles through each other (measured); the 4 cm
                          // garments' layers do not meet in their first second at the scenes' substeps,
                          // the dress's do at 4 substeps (94 pushes): that case checks the crossings
                          // where the self-collision acts
