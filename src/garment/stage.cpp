@@ -3,6 +3,7 @@
 
 #include "core/parallel.hpp"
 #include "world/garment_mesh.hpp"
+#include "world/mesh_distance.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -35,10 +36,30 @@ bool takesWater(const Model& model, const State& state, const ClothPiece& piece,
   return sat.unlimitedSupply || state.clothWater[size_t(i)] < waterCapacity(model.clothDryMass[size_t(i)], sat);
 }
 
-// each water particle's nearest cloth vertex within touch distance that takes water, or -1 (gather)
-void findTouches(const Model& model, const State& state, const NeighborLists& nb, std::vector<int32_t>& touch) {
+// the vertex of triangle t nearest x among those that take water, or -1
+int32_t nearestTakingVertex(const Model& model, const State& state, const ClothPiece& piece, uint32_t t, const Vec3& x) {
+  int32_t best = -1;
+  float bestD2 = std::numeric_limits<float>::infinity();
+  for (int v : model.triangles[t]) {
+    const float d2 = (state.particles.x[size_t(v)] - x).squaredNorm();
+    if (d2 < bestD2 && takesWater(model, state, piece, v)) {
+      bestD2 = d2;
+      best = v;
+    }
+  }
+  return best;
+}
+
+// each water particle's touch: the cloth vertex that takes water nearest to it within touch distance
+// (its neighbours), or, nearer still, a triangle of its path's coupling candidates whose surface is
+// within touch distance, at that triangle's nearest vertex that takes water; -1 where none (gather).
+// The triangles make the catch independent of the step: a drop the coupling stopped on the fabric
+// lies within the thickness of its surface but may be an edge length from every vertex.
+void findTouches(const Model& model, const State& state, const NeighborLists& nb, const DropCandidates& candidates,
+                 std::vector<int32_t>& touch) {
   const Particles& p = state.particles;
   const int64_t n = static_cast<int64_t>(p.size()), nc = model.numCloth;
+  const bool paths = candidates.start.size() == static_cast<size_t>(n - nc) + 1;  // searched for these particles
   touch.assign(static_cast<size_t>(n), -1);
   parallelFor(n - nc, [&](int64_t jj) {
     const int64_t j = nc + jj;
@@ -54,6 +75,21 @@ void findTouches(const Model& model, const State& state, const NeighborLists& nb
         best = d;
         hit = static_cast<int32_t>(i);
       }
+    }
+    for (uint32_t c = paths ? candidates.start[size_t(jj)] : 0; paths && c < candidates.start[size_t(jj) + 1]; ++c) {
+      const uint32_t t = candidates.triangles[c];
+      const auto& f = model.triangles[t];
+      const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[f[0]]))];
+      if (!piece.wetByContact) continue;
+      int feature = 0;
+      const Vec3d q = closestOnTriangle(p.x[size_t(j)].cast<double>(), p.x[f[0]].cast<double>(),
+                                        p.x[f[1]].cast<double>(), p.x[f[2]].cast<double>(), &feature);
+      const float d = static_cast<float>((q - p.x[size_t(j)].cast<double>()).norm());
+      if (!(d < touchDistance(model, piece) && d < best)) continue;
+      const int32_t v = nearestTakingVertex(model, state, piece, t, q.cast<float>());
+      if (v < 0) continue;
+      best = d;
+      hit = v;
     }
     touch[size_t(j)] = hit;
   });
@@ -236,8 +272,8 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
   });
 }
 
-size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,
-                         std::vector<uint8_t>& keep, double time) {
+size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, const DropCandidates& candidates,
+                         GarmentScratch& s, std::vector<uint8_t>& keep, double time) {
   // no cloth, or no piece wetted by contact (clothWetStart is then empty)
   if (model.numCloth == 0 || state.clothWetStart.size() != static_cast<size_t>(model.numCloth)) return 0;
   const Particles& p = state.particles;
@@ -252,7 +288,7 @@ size_t wetClothByContact(const Model& model, State& state, const NeighborLists& 
   }
   const int64_t n = static_cast<int64_t>(p.size());
   if (n == nc || nb.start.size() < static_cast<size_t>(n) + 1) return 0;
-  findTouches(model, state, nb, s.touch);
+  findTouches(model, state, nb, candidates, s.touch);
   // unlimited supply (Chen as printed): a vertex is wet when any water particle is within reach of it
   parallelFor(nc, [&](int64_t i) {
     const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[i]))];

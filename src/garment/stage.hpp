@@ -12,6 +12,7 @@
 #include "grid/grid.hpp"
 #include "world/colliders.hpp"
 
+#include <span>
 #include <vector>
 
 namespace soak {
@@ -30,6 +31,12 @@ struct GarmentScratch {
   std::vector<uint8_t> soakSeen;         // per cloth particle, during one drop's soak
 };
 
+// the cloth triangles near each water particle's path this substep (the coupling's candidates,
+// CouplingScratch): start[j - numCloth] .. start[j - numCloth + 1] in triangles. Empty: none searched
+struct DropCandidates {
+  std::span<const uint32_t> start, triangles;
+};
+
 // before the PBD stages, after predictPositions (which moves only water and PBD cloth): advances the
 // saturation of the pieces with wetByContact to state.time + h (updateSaturation; with Shao's wetting
 // on its S / S^MAX is used instead), sets the Eq. 15-19 mass of every piece with
@@ -46,14 +53,15 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
 // after commitPositions: the water that reaches the pieces with wetByContact, and the first wet time
 // of their vertices. With Shao's wetting on, a vertex is wet once it holds water (State::clothWater >
 // 0) and nothing else happens here. Without it, a water particle within touchDistance(piece) of a
-// vertex that still takes water soaks into the fabric from the nearest such vertex: into its
+// vertex that still takes water, or of the surface of one of its candidate triangles (at that
+// triangle's nearest vertex that takes water), soaks into the fabric from there: into its
 // clothWater up to delta m_dry, the rest into its mesh neighbours with room, nearest rings first
 // (every vertex that gets water is wet). Rain on fabric with no room for it stays water and runs off.
 // A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
 // reaches, and the particle vanishes when the piece has dropsVanish (WaterLedger::takenByCloth).
 // time is the end of the substep. Returns the number of water particles taken.
-size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, GarmentScratch& s,
-                         std::vector<uint8_t>& keep, double time);
+size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, const DropCandidates& candidates,
+                         GarmentScratch& s, std::vector<uint8_t>& keep, double time);
 
 // per cloth particle, how wet it is in [0, 1]: the saturation s = Q / delta (Eq. 18) of the pieces
 // with wetByContact (S / S^MAX with Shao's wetting on), 0 elsewhere (the "wetness" attribute of the

@@ -124,7 +124,8 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
   updateVelocitiesAndCommit(model, ws, state.particles, h, stats, clock);           // v, then x = x*
   if (wetDt > 0.0f) wet(model, state, ws, wetDt, clock);                            // absorb, diffuse, drip, stick
   clock.lap(stats.ms.wetting);
-  stats.garment.dropsTaken += wetClothByContact(model, state, ws.neighbors, ws.garment, ws.keep, state.time + h);
+  const DropCandidates paths{ws.coupling.candidateStart, ws.coupling.candidates};  // the coupling's, this substep
+  stats.garment.dropsTaken += wetClothByContact(model, state, ws.neighbors, paths, ws.garment, ws.keep, state.time + h);
   clock.lap(stats.ms.garment);                                                      // Chen 2012: wet by contact
   stats.removedParticles += removeOutsideDomain(model, state, ws.keep);             // counted in the ledger
   clock.lap(stats.ms.velocities);

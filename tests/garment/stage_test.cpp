@@ -40,10 +40,11 @@ struct WetStage {
   NeighborLists nb;
   GarmentScratch scratch;
   std::vector<uint8_t> keep;
+  DropCandidates candidates;  // the triangles near each water particle's path (none by default)
   size_t operator()(const Model& m, State& state, double time) {
     buildGrid(state.particles.x, 0.04f, grid);
     buildNeighborLists(state.particles.x, state.particles.radius, grid, nb);
-    return wetClothByContact(m, state, nb, scratch, keep, time);
+    return wetClothByContact(m, state, nb, candidates, scratch, keep, time);
   }
 };
 
@@ -121,6 +122,40 @@ TEST(GarmentStage, ADropGoesIntoTheNearestVertexWithRoomAndRunsOffAFullOne) {
   EXPECT_EQ(stage(m, s.state, 0.75), 0u);
   EXPECT_EQ(p.size(), size_t(m.numCloth) + 1);
   EXPECT_EQ(s.state.clothWater[60], capacity);
+}
+
+// a drop on the fabric's surface but farther than touchDistance from every vertex (over a triangle,
+// within reach of its plane): the vertices alone miss it; with the triangle among its path's
+// candidates it soaks in at that triangle's nearest vertex. A candidate whose surface is out of
+// reach takes nothing
+TEST(GarmentStage, ADropOnATriangleFarFromItsVerticesSoaksInThroughTheTriangle) {
+  Scene s = fromString(kSheet);
+  const Model& m = s.model;
+  const float reach = touchDistance(m, m.pieces[0]);  // 0.028 m, vertices 0.04 m apart
+  const Vec3 n = sheetNormal(m);
+  const std::vector<Vec3>& x0 = m.clothRestPosition;
+  uint32_t t = 0;
+  while (m.triangles[t][0] != 60 && m.triangles[t][1] != 60 && m.triangles[t][2] != 60) ++t;
+  const auto& f = m.triangles[t];
+  const Vec3 onFace = 0.4f * x0[f[0]] + 0.3f * x0[f[1]] + 0.3f * x0[f[2]];
+  const Vec3 drop = onFace + 0.9f * reach * n;
+  int nearest = f[0];
+  for (int v : f) {
+    ASSERT_GT((x0[v] - drop).norm(), reach) << v;  // no vertex within reach
+    if ((x0[v] - onFace).norm() < (x0[nearest] - onFace).norm()) nearest = v;
+  }
+  Particles& p = s.state.particles;
+  const float mass = float(0.25 * waterCapacity(m.clothDryMass[60], m.pieces[0].garment.saturation));
+  p.add(kWaterPhase, 1000, mass, 0.04f, drop, Vec3::Zero());
+  p.add(kWaterPhase, 1001, mass, 0.04f, onFace + 1.1f * reach * n, Vec3::Zero());  // its surface out of reach
+  WetStage stage;
+  EXPECT_EQ(stage(m, s.state, 0.5), 0u);  // the vertices alone
+  const std::vector<uint32_t> start{0, 1, 2}, triangles{t, t};
+  stage.candidates = {start, triangles};
+  EXPECT_EQ(stage(m, s.state, 0.5), 1u);
+  ASSERT_EQ(p.size(), size_t(m.numCloth) + 1);
+  EXPECT_EQ(p.id.back(), 1001u);
+  for (int i = 0; i < m.numCloth; ++i) EXPECT_EQ(s.state.clothWater[size_t(i)], i == nearest ? double(mass) : 0.0) << i;
 }
 
 // a drop heavier than a vertex holds soaks into the spot around it: the touched vertex fills, the
