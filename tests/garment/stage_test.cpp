@@ -477,8 +477,8 @@ TEST(GarmentRun, WetSilkOnTheBallHangsLowerThanDry) {
 
 // Fig. 2 / 9 of Chen 2012: the sewn T-shirt soaked against dry, 3 s on the still (smooth) mannequin
 // (at 4 cm edges; the wrinkle disturbances off: they are random pushes). The wet one is heavier (m_dry
-// (1 + delta)) and hangs lower: its lowest point (measured 13.4 mm lower) and its mean height (11.6 mm);
-// held by the contact rows, it rests closer to the body (2.34 against 2.51 cm on average; docs/garment.md,
+// (1 + delta)) and hangs lower: its lowest point (measured 10.4 mm lower) and its mean height (10.1 mm);
+// held by the contact rows, it rests closer to the body (2.37 against 2.48 cm on average; docs/garment.md,
 // "Wet against dry")
 TEST(GarmentRun, ASoakedShirtHangsLowerThanADryOne) {
   const std::string scene = std::string(SOAK_SOURCE_DIR) + "/scenes/chen_fig9_garment_rain_dry.json";
