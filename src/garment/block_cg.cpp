@@ -10,11 +10,42 @@ namespace soak {
 
 namespace {
 
-// sum of per-row terms in row order: the same for any thread count
-double orderedSum(const std::vector<double>& terms) {
+// rows per chunk of a dot product: each chunk's partial sum runs in row order and the chunks' sums
+// are added in chunk order, so a sum does not depend on the thread count
+constexpr int64_t kSumChunk = 256;
+
+int64_t sumChunks(int64_t n) { return (n + kSumChunk - 1) / kSumChunk; }
+
+// the sum of term(i) over the rows i of chunk c, in row order (term may also write row i's results)
+template <class Term>
+double chunkSum(int64_t n, int64_t c, Term&& term) {
+  double sum = 0.0;
+  for (int64_t i = c * kSumChunk, end = std::min(n, (c + 1) * kSumChunk); i < end; ++i) sum += term(i);
+  return sum;
+}
+
+// the partial sums added in chunk order
+double addPartials(const std::vector<double>& partial) {
   double s = 0.0;
-  for (double t : terms) s += t;
+  for (double t : partial) s += t;
   return s;
+}
+
+// the sum of f(c) over the chunks c of n rows, the chunks in parallel where the rows are many
+// (parallelFor's grain)
+template <class ChunkFn>
+double sumOfChunks(int64_t n, std::vector<double>& partial, ChunkFn&& f) {
+  const int64_t chunks = sumChunks(n);
+  partial.resize(static_cast<size_t>(chunks));
+#pragma omp parallel for schedule(static) if (n >= kParallelGrain)
+  for (int64_t c = 0; c < chunks; ++c) partial[c] = f(c);
+  return addPartials(partial);
+}
+
+// sum over rows i of term(i)
+template <class Term>
+double chunkedSum(int64_t n, std::vector<double>& partial, Term&& term) {
+  return sumOfChunks(n, partial, [&](int64_t c) { return chunkSum(n, c, term); });
 }
 
 }  // namespace
@@ -25,9 +56,7 @@ void BlockMatrix::multiply(const std::vector<Vec3d>& x, std::vector<Vec3d>& y) c
 }
 
 double blockDot(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, std::vector<double>& partial) {
-  partial.resize(a.size());
-  parallelFor(static_cast<int64_t>(a.size()), [&](int64_t i) { partial[i] = a[i].dot(b[i]); });
-  return orderedSum(partial);
+  return chunkedSum(static_cast<int64_t>(a.size()), partial, [&](int64_t i) { return a[i].dot(b[i]); });
 }
 
 namespace {
@@ -53,18 +82,27 @@ void invertDiagonal(const BlockMatrix& A, const Filter& filter, CgScratch& w) {
   });
 }
 
-// s = filter(P^-1 r); returns r^T s, summed in row order
-double precondition(const std::vector<Vec3d>& r, const Filter& filter, CgPreconditioner kind, CgScratch& w,
-                    std::vector<Vec3d>& s) {
-  const int64_t n = static_cast<int64_t>(r.size());
+// s_i = filter(P_i^-1 r_i) for block Jacobi; for the other preconditioners s holds P^-1 r already
+// and is filtered here. Returns r_i^T s_i (s's row i written)
+inline double preconditionRow(const std::vector<Vec3d>& r, const Filter& filter, CgPreconditioner kind,
+                              const CgScratch& w, std::vector<Vec3d>& s, int64_t i) {
+  s[i] = filter(i, kind == CgPreconditioner::BlockJacobi ? Vec3d(w.precond[i] * r[i]) : s[i]);
+  return r[i].dot(s[i]);
+}
+
+// the global part of the Cholesky or multigrid preconditioner: s = P^-1 r (block Jacobi is per row)
+void applyGlobal(const std::vector<Vec3d>& r, CgPreconditioner kind, CgScratch& w, std::vector<Vec3d>& s) {
   s.resize(r.size());
   if (kind == CgPreconditioner::Cholesky) w.cholesky.solve(r, s);
   if (kind == CgPreconditioner::Multigrid) w.multigrid.apply(r, s);
-  parallelFor(n, [&](int64_t i) {
-    s[i] = filter(i, kind == CgPreconditioner::BlockJacobi ? Vec3d(w.precond[i] * r[i]) : s[i]);
-    w.partial[i] = r[i].dot(s[i]);
-  });
-  return orderedSum(w.partial);
+}
+
+// s = filter(P^-1 r); returns r^T s
+double precondition(const std::vector<Vec3d>& r, const Filter& filter, CgPreconditioner kind, CgScratch& w,
+                    std::vector<Vec3d>& s) {
+  applyGlobal(r, kind, w, s);
+  return chunkedSum(static_cast<int64_t>(r.size()), w.partial,
+                    [&](int64_t i) { return preconditionRow(r, filter, kind, w, s, i); });
 }
 
 // the solve's start: the preconditioner (as asked for, or block Jacobi if its factor fails),
@@ -76,7 +114,6 @@ CgPreconditioner startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, con
   const int64_t n = A.rows;
   w.r.resize(static_cast<size_t>(n));
   w.q.resize(static_cast<size_t>(n));
-  w.partial.resize(static_cast<size_t>(n));
   CgPreconditioner kind = options.preconditioner;
   const bool factored = kind == CgPreconditioner::Cholesky    ? w.cholesky.factor(A, filter.kind, filter.normal)
                         : kind == CgPreconditioner::Multigrid ? w.multigrid.setup(A, filter.kind, filter.normal)
@@ -111,33 +148,71 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
     return result;
   }
   const double tol2 = options.tolerance * options.tolerance;
-  while (deltaNew > tol2 * delta0 && result.iterations < options.maxIterations) {
-    // q = filter(A c)
-    parallelFor(n, [&](int64_t i) {
+  const int64_t chunks = sumChunks(n);
+  w.partial.resize(static_cast<size_t>(chunks));
+  double alpha = 0.0, beta = 0.0;
+  // the passes of an iteration. q = filter(A c) and c^T q, over chunk c of the rows
+  const auto product = [&](int64_t c) {
+    return chunkSum(n, c, [&](int64_t i) {
       if (rowHeld(constrained[i])) {
         w.q[i].setZero();
-        w.partial[i] = 0.0;
-        return;
+        return 0.0;
       }
       w.q[i] = filter(i, A.row(w.c, i));
-      w.partial[i] = w.c[i].dot(w.q[i]);
+      return w.c[i].dot(w.q[i]);
     });
-    const double cq = orderedSum(w.partial);
-    if (!(cq > 0.0)) {
-      result.breakdown = true;
-      break;
-    }
-    const double alpha = deltaNew / cq;
-    // x += alpha c, r -= alpha q (filtered rows of c, q, r are zero), s = filter(P^-1 r)
-    parallelFor(n, [&](int64_t i) {
-      x[i] += alpha * w.c[i];
-      w.r[i] -= alpha * w.q[i];
+  };
+  // x += alpha c, r -= alpha q (filtered rows of c, q, r are zero)
+  const auto step = [&](int64_t i) {
+    x[i] += alpha * w.c[i];
+    w.r[i] -= alpha * w.q[i];
+  };
+  // with block Jacobi also s = filter(P^-1 r) and r^T s, in the same pass
+  const auto stepAndPrecondition = [&](int64_t c) {
+    return chunkSum(n, c, [&](int64_t i) {
+      step(i);
+      return preconditionRow(w.r, filter, kind, w, w.s, i);
     });
-    const double deltaOld = deltaNew;
-    deltaNew = precondition(w.r, filter, kind, w, w.s);
-    const double beta = deltaNew / deltaOld;
-    parallelFor(n, [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; });
+  };
+  const auto direction = [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; };
+  // after c^T q: alpha, or the breakdown of a matrix that is not positive definite
+  const auto takeStep = [&](double cq) {
+    result.breakdown = !(cq > 0.0);
+    alpha = deltaNew / cq;
+    return !result.breakdown;
+  };
+  // after r^T s: beta, and whether to go on
+  const auto nextDirection = [&](double rs) {
+    beta = rs / deltaNew;
+    deltaNew = rs;
     ++result.iterations;
+    return deltaNew > tol2 * delta0 && result.iterations < options.maxIterations;
+  };
+  bool more = deltaNew > tol2 * delta0 && result.iterations < options.maxIterations;
+  if (kind == CgPreconditioner::BlockJacobi) {
+    // one parallel region for the whole solve: the passes are parted by the loops' barriers, the
+    // scalars computed by one thread (fork and join four times an iteration cost as much as a pass)
+#pragma omp parallel if (n >= kParallelGrain)
+    while (more) {
+#pragma omp for schedule(static)
+      for (int64_t c = 0; c < chunks; ++c) w.partial[c] = product(c);
+#pragma omp single
+      more = takeStep(addPartials(w.partial));
+      if (!more) break;
+#pragma omp for schedule(static)
+      for (int64_t c = 0; c < chunks; ++c) w.partial[c] = stepAndPrecondition(c);
+#pragma omp single
+      more = nextDirection(addPartials(w.partial));
+#pragma omp for schedule(static)
+      for (int64_t i = 0; i < n; ++i) direction(i);
+    }
+  } else {
+    while (more) {
+      if (!takeStep(sumOfChunks(n, w.partial, product))) break;
+      parallelFor(n, step);
+      more = nextDirection(precondition(w.r, filter, kind, w, w.s));
+      parallelFor(n, direction);
+    }
   }
   result.residual = std::sqrt(std::max(deltaNew, 0.0) / delta0);
   result.converged = !result.breakdown && deltaNew <= tol2 * delta0;

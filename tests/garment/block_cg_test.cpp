@@ -8,6 +8,8 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -181,25 +183,31 @@ TEST(GarmentCg, MultiplyMatchesTheDenseProduct) {
   for (int i = 0; i < n; ++i) EXPECT_LT((y[i] - yd.segment<3>(3 * i)).norm(), 1e-12) << i;
 }
 
-// blockDot: the per-row dot products, summed in row order (bit for bit the serial loop), with the
-// per-row terms left in `partial`
-TEST(GarmentCg, BlockDotIsTheRowOrderedSum) {
+// blockDot: the per-row dot products summed in row order within chunks of 256 rows, the chunks' sums
+// (left in `partial`) added in chunk order: bit for bit that serial loop, at any thread count
+TEST(GarmentCg, BlockDotSumsFixedChunksInOrder) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Vec3d> a(40), b(40);
+  std::vector<Vec3d> a(3000), b(3000);  // more than parallelFor's grain: the chunks run in parallel
   for (size_t i = 0; i < a.size(); ++i) a[i] = Vec3d(u(rng), 1e6 * u(rng), u(rng)), b[i] = Vec3d(u(rng), u(rng), 1e-6 * u(rng));
-  std::vector<double> partial;
-  const double dot = blockDot(a, b, partial);
+  std::vector<double> chunk((a.size() + 255) / 256, 0.0);
+  for (size_t i = 0; i < a.size(); ++i) chunk[i / 256] += a[i].dot(b[i]);
   double serial = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) serial += a[i].dot(b[i]);
-  EXPECT_EQ(dot, serial);
-  ASSERT_EQ(partial.size(), a.size());
-  EXPECT_EQ(partial[17], a[17].dot(b[17]));
+  for (double c : chunk) serial += c;
+  const int before = omp_get_max_threads();
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    std::vector<double> partial;
+    EXPECT_EQ(blockDot(a, b, partial), serial) << threads;
+    EXPECT_EQ(partial, chunk) << threads;
+  }
+  omp_set_num_threads(before);
   // rounding shows the order: 5 x 0.75 then 1e16 gives 1e16 + 4 (the spacing of doubles there is 2), and
   // -1e16 leaves 4; summed from the end it would be 0 + 3.75
   std::vector<Vec3d> c(5, Vec3d(0.75, 0, 0)), e(7, Vec3d(1, 0, 0));
   c.push_back(Vec3d(1e16, 0, 0));
   c.push_back(Vec3d(-1e16, 0, 0));
+  std::vector<double> partial;
   EXPECT_EQ(blockDot(c, e, partial), 4.0);
 }
 
