@@ -303,6 +303,12 @@ size_t wetClothByContact(const Model& model, State& state, const NeighborLists& 
       }
     }
   });
+  for (int64_t j = nc; j < n; ++j) {  // and the vertex a particle touched, through a triangle too
+    const int32_t i = s.touch[size_t(j)];
+    if (i >= 0 && model.pieces[size_t(clothPiece(p.phase[i]))].garment.saturation.unlimitedSupply &&
+        !std::isfinite(state.clothWetStart[size_t(i)]))
+      state.clothWetStart[size_t(i)] = now;
+  }
   return takeTouchingWater(model, state, s, now, keep);
 }
 

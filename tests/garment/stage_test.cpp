@@ -126,8 +126,8 @@ TEST(GarmentStage, ADropGoesIntoTheNearestVertexWithRoomAndRunsOffAFullOne) {
 
 // a drop on the fabric's surface but farther than touchDistance from every vertex (over a triangle,
 // within reach of its plane): the vertices alone miss it; with the triangle among its path's
-// candidates it soaks in at that triangle's nearest vertex. A candidate whose surface is out of
-// reach takes nothing
+// candidates it soaks in at that triangle's nearest vertex (with an unlimited supply it vanishes
+// and wets that vertex). A candidate whose surface is out of reach takes nothing
 TEST(GarmentStage, ADropOnATriangleFarFromItsVerticesSoaksInThroughTheTriangle) {
   Scene s = fromString(kSheet);
   const Model& m = s.model;
@@ -156,6 +156,16 @@ TEST(GarmentStage, ADropOnATriangleFarFromItsVerticesSoaksInThroughTheTriangle) 
   ASSERT_EQ(p.size(), size_t(m.numCloth) + 1);
   EXPECT_EQ(p.id.back(), 1001u);
   for (int i = 0; i < m.numCloth; ++i) EXPECT_EQ(s.state.clothWater[size_t(i)], i == nearest ? double(mass) : 0.0) << i;
+
+  // with an unlimited supply the drop vanishes into the fabric and wets that vertex
+  Scene u = fromString(kSheet, {"cloth.0.saturation.supply=\"unlimited\""});
+  u.state.particles.add(kWaterPhase, 1000, mass, 0.04f, drop, Vec3::Zero());
+  WetStage unlimited;
+  unlimited.candidates = {std::span<const uint32_t>(start).first(2), std::span<const uint32_t>(triangles).first(1)};
+  EXPECT_EQ(unlimited(u.model, u.state, 0.5), 1u);
+  EXPECT_EQ(u.state.particles.size(), size_t(u.model.numCloth));
+  for (int i = 0; i < u.model.numCloth; ++i)
+    EXPECT_EQ(std::isfinite(u.state.clothWetStart[size_t(i)]), i == nearest) << i;
 }
 
 // a drop heavier than a vertex holds soaks into the spot around it: the touched vertex fills, the
