@@ -130,68 +130,64 @@ CgPreconditioner startPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, con
   return kind;
 }
 
-}  // namespace
-
-CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
-                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w,
-                     std::span<const Vec3d> contactNormal) {
-  const int64_t n = A.rows;
-  CgResult result;
-  double delta0 = 0.0, deltaNew = 0.0;
-  const Filter filter{constrained, contactNormal};
-  const CgPreconditioner kind = startPcg(A, b, filter, x, options, w, result, delta0, deltaNew);
-  if (!(delta0 > 0.0)) delta0 = deltaNew;
-  if (!(delta0 > 0.0)) {
-    // nothing to solve (b and r are zero), or r^T P^-1 r < 0: the matrix is not positive definite
-    result.converged = delta0 == 0.0;
-    result.breakdown = !result.converged;
-    return result;
-  }
-  const double tol2 = options.tolerance * options.tolerance;
-  const int64_t chunks = sumChunks(n);
-  w.partial.resize(static_cast<size_t>(chunks));
+// the iterations of one solve after its start (startPcg): the state the passes share
+struct PcgIterations {
+  const BlockMatrix& A;
+  const Filter& filter;
+  CgPreconditioner kind;
+  std::vector<Vec3d>& x;
+  CgScratch& w;
+  CgResult& result;
+  double delta0, deltaNew, tol2;
+  int maxIterations;
+  int64_t n = A.rows;
   double alpha = 0.0, beta = 0.0;
-  // the passes of an iteration. q = filter(A c) and c^T q, over chunk c of the rows
-  const auto product = [&](int64_t c) {
+
+  // q = filter(A c) and c^T q, over chunk c of the rows
+  double product(int64_t c) {
     return chunkSum(n, c, [&](int64_t i) {
-      if (rowHeld(constrained[i])) {
+      if (rowHeld(filter.kind[i])) {
         w.q[i].setZero();
         return 0.0;
       }
       w.q[i] = filter(i, A.row(w.c, i));
       return w.c[i].dot(w.q[i]);
     });
-  };
+  }
   // x += alpha c, r -= alpha q (filtered rows of c, q, r are zero)
-  const auto step = [&](int64_t i) {
+  void step(int64_t i) {
     x[i] += alpha * w.c[i];
     w.r[i] -= alpha * w.q[i];
-  };
+  }
   // with block Jacobi also s = filter(P^-1 r) and r^T s, in the same pass
-  const auto stepAndPrecondition = [&](int64_t c) {
+  double stepAndPrecondition(int64_t c) {
     return chunkSum(n, c, [&](int64_t i) {
       step(i);
       return preconditionRow(w.r, filter, kind, w, w.s, i);
     });
-  };
-  const auto direction = [&](int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; };
-  // after c^T q: alpha, or the breakdown of a matrix that is not positive definite
-  const auto takeStep = [&](double cq) {
+  }
+  void direction(int64_t i) { w.c[i] = w.s[i] + beta * w.c[i]; }
+  // after c^T q: alpha, or false at the breakdown of a matrix that is not positive definite
+  bool takeStep(double cq) {
     result.breakdown = !(cq > 0.0);
     alpha = deltaNew / cq;
     return !result.breakdown;
-  };
+  }
+  bool goOn() const { return deltaNew > tol2 * delta0 && result.iterations < maxIterations; }
   // after r^T s: beta, and whether to go on
-  const auto nextDirection = [&](double rs) {
+  bool nextDirection(double rs) {
     beta = rs / deltaNew;
     deltaNew = rs;
     ++result.iterations;
-    return deltaNew > tol2 * delta0 && result.iterations < options.maxIterations;
-  };
-  bool more = deltaNew > tol2 * delta0 && result.iterations < options.maxIterations;
-  if (kind == CgPreconditioner::BlockJacobi) {
-    // one parallel region for the whole solve: the passes are parted by the loops' barriers, the
-    // scalars computed by one thread (fork and join four times an iteration cost as much as a pass)
+    return goOn();
+  }
+
+  // block Jacobi: one parallel region for the whole solve, the passes parted by the loops' barriers,
+  // the scalars computed by one thread (fork and join four times an iteration cost as much as a pass)
+  void runPerRow() {
+    const int64_t chunks = sumChunks(n);
+    w.partial.resize(static_cast<size_t>(chunks));
+    bool more = goOn();
 #pragma omp parallel if (n >= kParallelGrain)
     while (more) {
 #pragma omp for schedule(static)
@@ -206,16 +202,42 @@ CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const st
 #pragma omp for schedule(static)
       for (int64_t i = 0; i < n; ++i) direction(i);
     }
-  } else {
-    while (more) {
-      if (!takeStep(sumOfChunks(n, w.partial, product))) break;
-      parallelFor(n, step);
+  }
+  // Cholesky and multigrid: their global solve between the passes, each pass its own parallel loop
+  void runGlobal() {
+    for (bool more = goOn(); more;) {
+      if (!takeStep(sumOfChunks(n, w.partial, [&](int64_t c) { return product(c); }))) break;
+      parallelFor(n, [&](int64_t i) { step(i); });
       more = nextDirection(precondition(w.r, filter, kind, w, w.s));
-      parallelFor(n, direction);
+      parallelFor(n, [&](int64_t i) { direction(i); });
     }
   }
-  result.residual = std::sqrt(std::max(deltaNew, 0.0) / delta0);
-  result.converged = !result.breakdown && deltaNew <= tol2 * delta0;
+};
+
+}  // namespace
+
+CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
+                     std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w,
+                     std::span<const Vec3d> contactNormal) {
+  CgResult result;
+  double delta0 = 0.0, deltaNew = 0.0;
+  const Filter filter{constrained, contactNormal};
+  const CgPreconditioner kind = startPcg(A, b, filter, x, options, w, result, delta0, deltaNew);
+  if (!(delta0 > 0.0)) delta0 = deltaNew;
+  if (!(delta0 > 0.0)) {
+    // nothing to solve (b and r are zero), or r^T P^-1 r < 0: the matrix is not positive definite
+    result.converged = delta0 == 0.0;
+    result.breakdown = !result.converged;
+    return result;
+  }
+  const double tol2 = options.tolerance * options.tolerance;
+  PcgIterations it{A, filter, kind, x, w, result, delta0, deltaNew, tol2, options.maxIterations};
+  if (kind == CgPreconditioner::BlockJacobi)
+    it.runPerRow();
+  else
+    it.runGlobal();
+  result.residual = std::sqrt(std::max(it.deltaNew, 0.0) / delta0);
+  result.converged = !result.breakdown && it.deltaNew <= tol2 * delta0;
   return result;
 }
 
