@@ -76,15 +76,17 @@ void findTouches(const Model& model, const State& state, const NeighborLists& nb
         hit = static_cast<int32_t>(i);
       }
     }
-    for (uint32_t c = paths ? candidates.start[size_t(jj)] : 0; paths && c < candidates.start[size_t(jj) + 1]; ++c) {
+    const uint32_t first = paths ? candidates.start[size_t(jj)] : 0, last = paths ? candidates.start[size_t(jj) + 1] : 0;
+    const Vec3d xj = p.x[size_t(j)].cast<double>();
+    for (uint32_t c = first; c < last; ++c) {
       const uint32_t t = candidates.triangles[c];
       const auto& f = model.triangles[t];
       const ClothPiece& piece = model.pieces[size_t(clothPiece(p.phase[f[0]]))];
       if (!piece.wetByContact) continue;
-      int feature = 0;
-      const Vec3d q = closestOnTriangle(p.x[size_t(j)].cast<double>(), p.x[f[0]].cast<double>(),
-                                        p.x[f[1]].cast<double>(), p.x[f[2]].cast<double>(), &feature);
-      const float d = static_cast<float>((q - p.x[size_t(j)].cast<double>()).norm());
+      int feature = 0;  // which part of the triangle is nearest: not needed here
+      const Vec3d q = closestOnTriangle(xj, p.x[f[0]].cast<double>(), p.x[f[1]].cast<double>(),
+                                        p.x[f[2]].cast<double>(), &feature);
+      const float d = static_cast<float>((q - xj).norm());
       if (!(d < touchDistance(model, piece) && d < best)) continue;
       const int32_t v = nearestTakingVertex(model, state, piece, t, q.cast<float>());
       if (v < 0) continue;

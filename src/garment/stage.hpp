@@ -58,7 +58,8 @@ void addCouplingVelocity(const Model& model, Particles& p, const GarmentScratch&
 // clothWater up to delta m_dry, the rest into its mesh neighbours with room, nearest rings first
 // (every vertex that gets water is wet). Rain on fabric with no room for it stays water and runs off.
 // A piece with saturation.unlimitedSupply (Chen as printed) instead is wet wherever a particle
-// reaches, and the particle vanishes when the piece has dropsVanish (WaterLedger::takenByCloth).
+// reaches (and at the vertex it touched), and the particle vanishes when the piece has dropsVanish
+// (WaterLedger::takenByCloth).
 // time is the end of the substep. Returns the number of water particles taken.
 size_t wetClothByContact(const Model& model, State& state, const NeighborLists& nb, const DropCandidates& candidates,
                          GarmentScratch& s, std::vector<uint8_t>& keep, double time);
