@@ -75,6 +75,7 @@ enum class CgPreconditioner : uint8_t {
   BlockJacobi,  // the inverse 3x3 diagonal blocks: cheap per iteration, hundreds of iterations on stiff cloth
   Cholesky,     // the exact sparse Cholesky factor of the filtered system: one iteration, a costly factor
   Multigrid,    // one V-cycle of two-level smoothed aggregation (garment/multigrid.hpp)
+  GaussSeidel,  // symmetric block Gauss-Seidel in a colour order, Eisenstat's form (garment/gauss_seidel_cg.hpp)
 };
 
 // everything the implicit garment solver of one cloth piece reads (implicit.hpp)
@@ -91,7 +92,7 @@ struct GarmentParams {
   float rayleighBeta = 3.81413e-3f;   // s, stiffness-proportional damping (Eq. 22)
   float cgTolerance = 1e-4f;          // relative preconditioned residual
   int cgMaxIterations = 300;
-  CgPreconditioner cgPreconditioner = CgPreconditioner::BlockJacobi;
+  CgPreconditioner cgPreconditioner = CgPreconditioner::GaussSeidel;
   bool cgWarmStart = false;           // the CG starts from the last substep's velocity change (State::clothVelocityChange)
   bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
 };

@@ -219,6 +219,8 @@ struct PcgIterations {
 CgResult filteredPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const std::vector<uint8_t>& constrained,
                      std::vector<Vec3d>& x, const CgOptions& options, CgScratch& w,
                      std::span<const Vec3d> contactNormal) {
+  if (options.preconditioner == CgPreconditioner::GaussSeidel)
+    return gaussSeidelPcg(A, b, constrained, contactNormal, x, options, w.gaussSeidel);
   CgResult result;
   double delta0 = 0.0, deltaNew = 0.0;
   const Filter filter{constrained, contactNormal};

@@ -3,14 +3,16 @@
 // use for Eq. 3-5: constrained vertices are filtered out of every search direction, so the solve
 // never moves them away from their prescribed value; a contact row is filtered along its normal only
 // (S_i = I - n n^T), so it keeps its prescribed normal velocity change and slides freely.
-// Preconditioned by block Jacobi, the exact sparse Cholesky factor of the filtered matrix
-// (sparse_cholesky.hpp) or a two-level multigrid V-cycle (multigrid.hpp). Double precision; every
+// Preconditioned by symmetric block Gauss-Seidel (gauss_seidel_cg.hpp), block Jacobi, the exact
+// sparse Cholesky factor of the filtered matrix (sparse_cholesky.hpp) or a two-level multigrid
+// V-cycle (multigrid.hpp). Double precision; every
 // sum runs in a fixed order, so the result does not depend on the thread count.
 #pragma once
 #include <soak/garment_params.hpp>
 #include <soak/math.hpp>
 
 #include "garment/block_matrix.hpp"
+#include "garment/gauss_seidel_cg.hpp"
 #include "garment/multigrid.hpp"
 #include "garment/sparse_cholesky.hpp"
 
@@ -23,6 +25,7 @@ struct CgOptions {
   double tolerance = 1e-5;  // stop when sqrt(r^T P^-1 r / b^T P^-1 b) <= tolerance (filtered r, b)
   int maxIterations = 500;
   CgPreconditioner preconditioner = CgPreconditioner::BlockJacobi;
+  bool sameMatrix = false;  // A's values are those of the last solve with this scratch (only the filter changed)
 };
 
 struct CgResult {
@@ -38,6 +41,7 @@ struct CgScratch {
   std::vector<Eigen::Matrix3d> precond;  // inverse diagonal blocks (block Jacobi)
   SparseCholesky cholesky;               // the factor and its pattern, kept from solve to solve
   Multigrid multigrid;                   // the levels of the last solve
+  GaussSeidelScratch gaussSeidel;        // the colour order and the sweeps' vectors
   std::vector<double> partial;           // per-chunk partial sums of the dot products
 };
 

@@ -337,6 +337,7 @@ void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, Imp
   for (int round = 0;; ++round) {
     const bool last = settled || round == kContactRounds;
     opt.tolerance = last ? tolerance : roundTolerance;
+    opt.sameMatrix = round > 0;  // the rounds change the filter and the right-hand side only
     const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg, w.contactNormal);
     stats.cgIterations += cg.iterations;
     stats.cgResidual = cg.residual;

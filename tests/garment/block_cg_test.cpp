@@ -2,6 +2,7 @@
 // solve uses: products against dense algebra, constrained rows held, the preconditioner, the reported
 // breakdown and iteration cap, and the same answer for any thread count
 #include "garment/block_cg.hpp"
+#include "support/block_systems.hpp"
 
 #include <soak/threads.hpp>
 
@@ -18,31 +19,9 @@
 namespace soak {
 namespace {
 
-// the 3x3 blocks of `dense` (3n x 3n) where it is not zero, diagonal first in each row
-BlockMatrix blocksOf(const Eigen::MatrixXd& dense) {
-  const int n = int(dense.rows() / 3);
-  BlockMatrix A;
-  A.rows = n;
-  A.rowStart.push_back(0);
-  for (int i = 0; i < n; ++i) {
-    A.col.push_back(i);
-    A.block.push_back(dense.block<3, 3>(3 * i, 3 * i));
-    for (int j = 0; j < n; ++j)
-      if (j != i && dense.block<3, 3>(3 * i, 3 * j).cwiseAbs().maxCoeff() > 0.0) {
-        A.col.push_back(j);
-        A.block.push_back(dense.block<3, 3>(3 * i, 3 * j));
-      }
-    A.rowStart.push_back(int(A.col.size()));
-  }
-  return A;
-}
-
-Eigen::Matrix3d randomBlock(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::Matrix3d b;
-  for (int k = 0; k < 9; ++k) b(k / 3, k % 3) = u(rng);
-  return b;
-}
+using testing::blocksOf;
+using testing::randomBlock;
+using testing::randomSpd;
 
 TEST(GarmentCg, FilteredPcgSolvesFreeRowsAndKeepsConstrainedRows) {
   // a random SPD 3x3-block tridiagonal matrix of 6 rows
@@ -140,7 +119,8 @@ TEST(GarmentCg, AContactRowIsHeldAlongItsNormalOnly) {
     zz.segment<3>(3 * i) = z[i];
   }
   const Eigen::VectorXd ref = zz + T * (T.transpose() * dense * T).ldlt().solve(T.transpose() * (bz - dense * zz));
-  for (CgPreconditioner pre : {CgPreconditioner::BlockJacobi, CgPreconditioner::Cholesky, CgPreconditioner::Multigrid}) {
+  for (CgPreconditioner pre : {CgPreconditioner::BlockJacobi, CgPreconditioner::Cholesky, CgPreconditioner::Multigrid,
+                               CgPreconditioner::GaussSeidel}) {
     std::vector<Vec3d> x = z;
     CgScratch scratch;
     CgOptions opt{1e-12, 200};
@@ -242,8 +222,10 @@ TEST(GarmentCg, IndefiniteMatrixIsReportedAsABreakdown) {
   dense << Eigen::Matrix3d::Identity(), 2.0 * Eigen::Matrix3d::Identity(), 2.0 * Eigen::Matrix3d::Identity(),
       Eigen::Matrix3d::Identity();
   const BlockMatrix A = blocksOf(dense);
-  // with the Cholesky preconditioner asked for, its factor fails, block Jacobi is used, and it says so
-  for (const CgPreconditioner kind : {CgPreconditioner::BlockJacobi, CgPreconditioner::Cholesky}) {
+  // with the Cholesky preconditioner asked for, its factor fails, block Jacobi is used, and it says so;
+  // symmetric Gauss-Seidel's M = [[I, 2I], [2I, 5I]] is positive definite, its first direction is not
+  for (const CgPreconditioner kind :
+       {CgPreconditioner::BlockJacobi, CgPreconditioner::Cholesky, CgPreconditioner::GaussSeidel}) {
     std::vector<Vec3d> b{Vec3d(1, 1, 1), Vec3d(-1, -1, -1)}, x(2, Vec3d::Zero());
     CgScratch scratch;
     CgOptions opt{1e-10, 100};
@@ -262,15 +244,19 @@ TEST(GarmentCg, IndefiniteMatrixIsReportedAsABreakdown) {
 TEST(GarmentCg, NegativeDefiniteDiagonalIsNotReportedAsConverged) {
   const Eigen::MatrixXd dense = -Eigen::MatrixXd::Identity(6, 6);
   const BlockMatrix A = blocksOf(dense);
-  std::vector<Vec3d> b(2, Vec3d(1, 2, 3)), x(2, Vec3d::Zero());
-  CgScratch scratch;
-  const CgResult res = filteredPcg(A, b, std::vector<uint8_t>(2, 0), x, CgOptions{1e-10, 100}, scratch);
-  std::vector<Vec3d> ax;
-  A.multiply(x, ax);
-  const double error = (ax[0] - b[0]).norm() + (ax[1] - b[1]).norm();
-  // either it solved the system, or it did not say it did
-  EXPECT_TRUE(!res.converged || error < 1e-8) << "converged with |Ax - b| = " << error;
-  EXPECT_TRUE(res.breakdown);
+  for (const CgPreconditioner kind : {CgPreconditioner::BlockJacobi, CgPreconditioner::GaussSeidel}) {
+    std::vector<Vec3d> b(2, Vec3d(1, 2, 3)), x(2, Vec3d::Zero());
+    CgScratch scratch;
+    CgOptions opt{1e-10, 100};
+    opt.preconditioner = kind;
+    const CgResult res = filteredPcg(A, b, std::vector<uint8_t>(2, 0), x, opt, scratch);
+    std::vector<Vec3d> ax;
+    A.multiply(x, ax);
+    const double error = (ax[0] - b[0]).norm() + (ax[1] - b[1]).norm();
+    // either it solved the system, or it did not say it did
+    EXPECT_TRUE(!res.converged || error < 1e-8) << "converged with |Ax - b| = " << error;
+    EXPECT_TRUE(res.breakdown);
+  }
 }
 
 // stopped by maxIterations: not converged, the iterations and the residual at exit reported; a zero
@@ -311,7 +297,8 @@ TEST(GarmentCg, IterationCapAndTrivialSystemsAreReported) {
   EXPECT_EQ(still, zero);
   std::vector<Vec3d> held(n, Vec3d(0.5, -1.0, 2.0));
   const std::vector<Vec3d> before = held;
-  for (CgPreconditioner kind : {CgPreconditioner::BlockJacobi, CgPreconditioner::Multigrid}) {  // no coarse level
+  for (CgPreconditioner kind : {CgPreconditioner::BlockJacobi, CgPreconditioner::Multigrid,  // no coarse level
+                                CgPreconditioner::GaussSeidel}) {
     CgOptions opt;
     opt.preconditioner = kind;
     res = filteredPcg(A, b, std::vector<uint8_t>(n, 1), held, opt, scratch);
@@ -362,23 +349,6 @@ TEST(GarmentCg, SameSolutionOnOneAndTwoThreadsForALargeSystem) {
     if (!constrained[i]) worst = std::max(worst, (ax[i] - b[i]).norm());
   EXPECT_LT(worst, 1e-7);
   EXPECT_EQ(one[97], Vec3d::Zero());  // constrained rows keep their value
-}
-
-// a random SPD block tridiagonal matrix of n rows with a coupling of rows 0 and n - 1 (fill for the
-// Cholesky factor), diagonal dominance `shift`
-Eigen::MatrixXd randomSpd(int n, double shift, unsigned seed) {
-  std::mt19937 rng(seed);
-  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  for (int i = 0; i + 1 < n; ++i) {
-    const Eigen::Matrix3d b = randomBlock(rng);
-    dense.block<3, 3>(3 * i, 3 * i + 3) = b;
-    dense.block<3, 3>(3 * i + 3, 3 * i) = b.transpose();
-  }
-  const Eigen::Matrix3d c = randomBlock(rng);
-  dense.block<3, 3>(0, 3 * n - 3) = c;
-  dense.block<3, 3>(3 * n - 3, 0) = c.transpose();
-  dense += shift * Eigen::MatrixXd::Identity(3 * n, 3 * n);
-  return dense;
 }
 
 // the Cholesky preconditioner is the exact inverse of the filtered matrix: one iteration reaches a
