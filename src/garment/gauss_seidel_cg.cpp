@@ -207,8 +207,8 @@ CgResult gaussSeidelPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const
     // w.ap): the scale of the residual
     sw.forward([&](int q) { return w.t[q]; }, w.z, [&](int q, const Vec3d& sigma) { w.ap[q] = w.t[q] - sigma; });
     const double d0 = sw.sumOver([&](int q) { return w.z[q].dot(w.ap[q]); }, partialA);
-    // the transformed residual r^ = D (D + L)^-1 r = r - L (D + L)^-1 r and s = D^-1 r^ = (D + L)^-1 r
-    // (in w.z); r^T D^-1 r^ is r^T M^-1 r
+    // the transformed residual r^ = D (D + L)^-1 r = r - L (D + L)^-1 r (in w.r) and s = D^-1 r^ =
+    // (D + L)^-1 r (in w.s); r^T D^-1 r^ is r^T M^-1 r
     sw.forward([&](int q) { return w.r[q]; }, w.s, [&](int q, const Vec3d& sigma) { w.r[q] -= sigma; });
     double g = sw.sumOver([&](int q) { return w.s[q].dot(w.r[q]); }, partialB);
     const double scale = d0 > 0.0 ? d0 : g;

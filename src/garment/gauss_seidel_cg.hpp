@@ -3,11 +3,12 @@
 // with the filtered matrix split as L + D + U (D its 3x3 diagonal blocks, as block Jacobi takes them;
 // L and U the blocks whose column comes earlier or later in the colour order), M = (D + L) D^-1 (D + U)
 // and the preconditioned product D (D + L)^-1 A (D + U)^-1 p = D (t + (D + L)^-1 (p - D t)),
-// t = (D + U)^-1 p: one backward and one forward sweep, together one pass over the blocks, cost about
-// what block Jacobi's product costs, in about half as many iterations on stiff cloth. The rows of
-// one colour share no block, so each sweep runs colour by colour, a colour's rows in parallel; the
-// colours come from a greedy colouring in row order, so the result does not depend on the thread
-// count. The residual is measured as r^T M^-1 r against b^T M^-1 b (CgOptions::tolerance).
+// t = (D + U)^-1 p: one backward and one forward sweep, together one pass over the blocks (an
+// iteration costs about 1.6 times block Jacobi's on the Fig. 9 shirt, 2 threads), in about half as
+// many iterations on stiff cloth. The rows of one colour share no block, so each sweep runs colour by
+// colour, a colour's rows in parallel; the colours and the sums' order are fixed, so the result does
+// not depend on the thread count. The residual is measured as r^T M^-1 r against b^T M^-1 b
+// (CgOptions::tolerance).
 #pragma once
 #include "garment/block_matrix.hpp"
 
