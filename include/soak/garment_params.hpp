@@ -92,7 +92,7 @@ struct GarmentParams {
   float rayleighBeta = 3.81413e-3f;   // s, stiffness-proportional damping (Eq. 22)
   float cgTolerance = 1e-4f;          // relative preconditioned residual
   int cgMaxIterations = 300;
-  CgPreconditioner cgPreconditioner = CgPreconditioner::GaussSeidel;
+  CgPreconditioner cgPreconditioner = CgPreconditioner::BlockJacobi;
   bool cgWarmStart = false;           // the CG starts from the last substep's velocity change (State::clothVelocityChange)
   bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
 };

@@ -111,7 +111,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.cgTolerance = cg.number("tolerance", d.cgTolerance, Range::positive());
   g.cgMaxIterations = cg.integer("maxIterations", d.cgMaxIterations, Range::between(1, kMaxCgIterations));
   g.cgPreconditioner = static_cast<CgPreconditioner>(
-      cg.choice("preconditioner", {"blockJacobi", "cholesky", "multigrid", "gaussSeidel"}, std::string("gaussSeidel")));
+      cg.choice("preconditioner", {"blockJacobi", "cholesky", "multigrid", "gaussSeidel"}, std::string("blockJacobi")));
   g.cgWarmStart = cg.boolean("warmStart", d.cgWarmStart);
   cg.finish();
   ObjectReader w = r.object("wrinkles");

@@ -442,8 +442,9 @@ TEST(GarmentImplicit, MultigridStepsMatchBlockJacobiInFarFewerIterations) {
   EXPECT_LT(5 * multigrid, jacobi);
 }
 
-// the symmetric Gauss-Seidel preconditioner (the default) gives the steps block Jacobi gives in about
-// half the iterations (measured 1,255 against 2,719 over 20 steps, the positions within 0.2 µm)
+// the symmetric Gauss-Seidel preconditioner (garment.cg.preconditioner "gaussSeidel") gives the steps
+// block Jacobi gives in about half the iterations (measured 1,255 against 2,719 over 20 steps, the
+// positions within 0.2 µm)
 TEST(GarmentImplicit, GaussSeidelStepsMatchBlockJacobiInAboutHalfTheIterations) {
   const PreconditionerRun run = againstBlockJacobi(CgPreconditioner::GaussSeidel, 30, 0.6f, 20);
   const int jacobi = std::accumulate(run.jacobi.begin(), run.jacobi.end(), 0);

@@ -307,10 +307,10 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_EQ(d.laws.shear.a1, defaults.laws.shear.a1);
   EXPECT_EQ(d.friction.peak, defaults.friction.peak);
   EXPECT_EQ(d.cgMaxIterations, defaults.cgMaxIterations);
-  EXPECT_EQ(d.cgPreconditioner, CgPreconditioner::GaussSeidel);
+  EXPECT_EQ(d.cgPreconditioner, CgPreconditioner::BlockJacobi);
   EXPECT_EQ(d.cgWarmStart, defaults.cgWarmStart);
-  EXPECT_EQ(fromString(kSheet, {"cloth.0.garment.cg.preconditioner=blockJacobi"}).model.pieces[0].garment.cgPreconditioner,
-            CgPreconditioner::BlockJacobi);
+  EXPECT_EQ(fromString(kSheet, {"cloth.0.garment.cg.preconditioner=gaussSeidel"}).model.pieces[0].garment.cgPreconditioner,
+            CgPreconditioner::GaussSeidel);
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.cg.warmStart=1"}), "at cloth[0].garment.cg.warmStart");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.cg.preconditioner=ilu"}),
              "at cloth[0].garment.cg.preconditioner: expected one of \"blockJacobi\", \"cholesky\"");
