@@ -191,7 +191,9 @@ CgResult gaussSeidelPcg(const BlockMatrix& A, const std::vector<Vec3d>& b, const
     copyBlocks(A, o, o.lower, w.lowerBlock, w.lowerCol);
     copyBlocks(A, o, o.upper, w.upperBlock, w.upperCol);
   }
-  for (auto* v : {&w.t, &w.z, &w.p, &w.r, &w.s, &w.ap, &w.dx, &w.normal}) v->assign(static_cast<size_t>(n), Vec3d::Zero());
+  for (auto* v : {&w.t, &w.z, &w.r, &w.s, &w.ap, &w.normal}) v->resize(static_cast<size_t>(n));  // written before read
+  w.p.assign(static_cast<size_t>(n), Vec3d::Zero());  // the first direction is r^ + 0 p
+  w.dx.assign(static_cast<size_t>(n), Vec3d::Zero());
   w.kind.resize(static_cast<size_t>(n));
   w.diagInv.resize(static_cast<size_t>(n));
   gatherRows(A, b, kind, normal, x, sameMatrix, w);

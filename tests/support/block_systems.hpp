@@ -4,7 +4,9 @@
 
 #include <Eigen/Dense>
 
+#include <cstdint>
 #include <random>
+#include <vector>
 
 namespace soak::testing {
 
@@ -49,6 +51,37 @@ inline Eigen::MatrixXd randomSpd(int n, double shift, unsigned seed) {
   dense.block<3, 3>(3 * n - 3, 0) = c.transpose();
   dense += shift * Eigen::MatrixXd::Identity(3 * n, 3 * n);
   return dense;
+}
+
+// the dense solution of the filtered system the PCG solves: x = z + T y with T^T A T y = T^T (b - A z),
+// T spanning the free rows (kind 0) and the contact rows' tangent planes (kContactRow, unit normal);
+// held rows keep z
+inline std::vector<Vec3d> filteredReference(const Eigen::MatrixXd& dense, const std::vector<Vec3d>& b,
+                                            const std::vector<Vec3d>& z, const std::vector<uint8_t>& kind,
+                                            const std::vector<Vec3d>& normal) {
+  const int n = int(b.size());
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  int cols = 0;
+  for (int i = 0; i < n; ++i) {
+    if (kind[i] == kFreeRow) {
+      T.block<3, 3>(3 * i, cols) = Eigen::Matrix3d::Identity();
+      cols += 3;
+    } else if (kind[i] == kContactRow) {
+      const Vec3d t1 = normal[i].unitOrthogonal(), t2 = normal[i].cross(t1);
+      T.block<3, 1>(3 * i, cols++) = t1;
+      T.block<3, 1>(3 * i, cols++) = t2;
+    }
+  }
+  T.conservativeResize(Eigen::NoChange, cols);
+  Eigen::VectorXd bz(3 * n), zz(3 * n);
+  for (int i = 0; i < n; ++i) {
+    bz.segment<3>(3 * i) = b[i];
+    zz.segment<3>(3 * i) = z[i];
+  }
+  const Eigen::VectorXd x = zz + T * (T.transpose() * dense * T).ldlt().solve(T.transpose() * (bz - dense * zz));
+  std::vector<Vec3d> out(n);
+  for (int i = 0; i < n; ++i) out[i] = x.segment<3>(3 * i);
+  return out;
 }
 
 }  // namespace soak::testing
