@@ -352,7 +352,9 @@ void printParts(const std::vector<json>& results) {
   }
   std::printf("(neighbors: grid, lists; cloth: solve (with the tethers), selfCollision; coupling: search (with Eq. 22's "
               "stiffness), passes (the rigid one too); velocities: xsph; wetting: its seven stages, once a step; "
-              "each within its stage's time above)\n");
+              "garment: assemble (forces, rows, system), cg (with the contact rounds), integrate (with the "
+              "collider and edge contact), selfContact, drops (wet by contact); each within its stage's time "
+              "above)\n");
 }
 
 }  // namespace

@@ -6,17 +6,19 @@ namespace soak {
 
 // parts of the stages below (ms), named "stage.part": the wetting stages one by one (Table 2 of Shao
 // 2017 gives the wetting's time apart from the total), and the parts of the neighbour search, cloth,
-// coupling and velocity stages (`soak bench --stages`; docs/performance.md on finding serial work)
+// coupling, velocity and implicit garment stages (`soak bench --stages`; docs/performance.md on
+// finding serial work)
 enum class StagePart : int {
   neighborsGrid, neighborsLists, clothSolve, clothSelfCollision, couplingSearch, couplingPasses, velocitiesXsph,
   wettingPorosity, wettingAbsorption, wettingDiffusion, wettingEmission, wettingAttraction, wettingSticking,
-  wettingFinish, count
+  wettingFinish, garmentAssemble, garmentCg, garmentIntegrate, garmentSelfContact, garmentDrops, count
 };
 inline constexpr int kStagePartCount = static_cast<int>(StagePart::count);
 inline constexpr const char* kStagePartNames[kStagePartCount] = {
     "neighbors.grid",     "neighbors.lists",    "cloth.solve",        "cloth.selfCollision", "coupling.search",
     "coupling.passes",    "velocities.xsph",    "wetting.porosity",   "wetting.absorption",  "wetting.diffusion",
-    "wetting.emission",   "wetting.attraction", "wetting.sticking",   "wetting.finish"};
+    "wetting.emission",   "wetting.attraction", "wetting.sticking",   "wetting.finish",      "garment.assemble",
+    "garment.cg",         "garment.integrate",  "garment.selfContact", "garment.drops"};
 
 struct StageTimes {         // ms of wall time per stage
   double emit = 0, predict = 0, neighbors = 0, water = 0, cloth = 0, coupling = 0, colliders = 0,

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -474,6 +475,13 @@ SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g,
   return pushes;
 }
 
+// adds the wall ms since `t` to `ms` and restarts `t` there (ImplicitStats' parts)
+void lap(std::chrono::steady_clock::time_point& t, double& ms) {
+  const auto now = std::chrono::steady_clock::now();
+  ms += std::chrono::duration<double, std::milli>(now - t).count();
+  t = now;
+}
+
 // the share of its starting gap a seam's rest length still has at `time`
 float seamOpenFraction(const SeamParams& seams, double time) {
   return seams.closeTime > 0.0f ? static_cast<float>(std::max(0.0, 1.0 - time / seams.closeTime)) : 0.0f;
@@ -486,6 +494,7 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
                            const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w,
                            std::span<Vec3> velocityChange) {
   ImplicitStats stats;
+  auto clock = std::chrono::steady_clock::now();
   const double hd = h;
   const bool sewn = g.springs.kindStart[4] > g.springs.kindStart[3];
   const bool sewing = sewn && time < params.seams.closeTime;
@@ -502,17 +511,21 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   for (int v = 0; !frictionless && v < g.count; ++v)
     w.fabricMu[v] = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
   contactRows(model, g, poses, p, h, w.fabricMu, w);
+  lap(clock, stats.msAssemble);
   const std::span<const Vec3> v0(p.v.data() + g.firstParticle, static_cast<size_t>(g.count));
   solveWithContact(params, v0, w, stats);
+  lap(clock, stats.msCg);
   if (velocityChange.size() == static_cast<size_t>(g.count))
     for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
   integrateWithContact(model, g, h, poses, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
+  lap(clock, stats.msIntegrate);
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision) {
     const SelfCollisionPushes pushes = selfCollisionStep(model, g, poses, p, w);
     stats.selfContacts = pushes.vertexTriangle;
     stats.selfEdgeContacts = pushes.edgeEdge;
   }
+  lap(clock, stats.msSelfContact);
   for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;
   return stats;
 }
@@ -521,11 +534,15 @@ ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const Ga
                              std::span<const float> saturation, float h, double time, uint64_t stepIndex,
                              const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch,
                              std::span<Vec3> velocityChange) {
+  auto clock = std::chrono::steady_clock::now();
   if (params.saturationMass) applySaturationMass(model, g.piece, saturation, params.saturation, p);  // Eq. 15-19
   const std::vector<PositionConstraint> wrinkles = computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses,
                                                                        params.wrinkles, stepIndex, saturation);  // 3.5
+  double msBefore = 0.0;
+  lap(clock, msBefore);
   ImplicitStats s =
       implicitStep(model, g, params, h, time, poses, saturation, wrinkles, p, scratch, velocityChange);  // Eq. 1-5
+  s.msAssemble += msBefore;
   s.disturbances = static_cast<int>(wrinkles.size());
   return s;
 }

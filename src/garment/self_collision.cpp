@@ -410,6 +410,53 @@ void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invM
 
 }  // namespace
 
+namespace {
+
+// whether none of a test's four points moved since the push counter stood at `tested`
+bool unmovedSince(const std::array<int, 4>& id, const std::vector<uint32_t>& lastMove, uint32_t tested) {
+  return lastMove[id[0]] <= tested && lastMove[id[1]] <= tested && lastMove[id[2]] <= tested && lastMove[id[3]] <= tested;
+}
+
+// kPasses Gauss-Seidel passes over the step's pairs, vertex-triangle then edge-edge. A test reads only
+// its four points' end positions (their start positions and masses are constant), so a pair found
+// clear is skipped until one of its points moves: the same pushes as testing every pair every pass
+SelfCollisionPushes pushPairs(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, float thickness,
+                              const Vec3* x0, Vec3* x1, Vec3* vel, SelfCollisionScratch& s) {
+  const auto& tris = mesh.triangles;
+  const auto& edges = mesh.edges;
+  uint32_t pushed = 0;  // pushes so far; lastMove[v] = the count after v's last push
+  s.lastMove.assign(s.moved.size(), 0);
+  s.testedAt.assign(s.pairs.size() + s.edgePairs.size(), 0);
+  const auto test = [&](size_t k, const std::array<int, 4>& id, bool pass0, auto&& push) {
+    if (!pass0 && unmovedSince(id, s.lastMove, s.testedAt[k])) return false;
+    s.testedAt[k] = pushed;
+    Four f(id, x0, x1, vel, invMass);
+    if (!push(f)) return false;
+    f.store(x1, vel, s.moved);
+    ++pushed;
+    for (int v : id) s.lastMove[v] = pushed;
+    return true;
+  };
+  SelfCollisionPushes pushes;
+  for (int pass = 0; pass < kPasses; ++pass) {
+    for (size_t k = 0; k < s.pairs.size(); ++k) {
+      const auto& [i, t] = s.pairs[k];
+      const auto& tri = tris[t];
+      pushes.vertexTriangle += test(k, {i, tri[0], tri[1], tri[2]}, pass == 0, [&](Four& f) {
+        return pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness);
+      });
+    }
+    for (size_t k = 0; k < s.edgePairs.size(); ++k) {
+      const auto& [a, b] = s.edgePairs[k];
+      pushes.edgeEdge += test(s.pairs.size() + k, {edges[a][0], edges[a][1], edges[b][0], edges[b][1]}, pass == 0,
+                              [&](Four& f) { return pushEdgeOffEdge(f.x0, f.x1, f.v, f.w, thickness); });
+    }
+  }
+  return pushes;
+}
+
+}  // namespace
+
 SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass,
                                 float thickness, Particles& p, SelfCollisionScratch& s) {
   const auto& tris = mesh.triangles;
@@ -423,32 +470,21 @@ SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int co
   s.moved.assign(static_cast<size_t>(count), 0);
   // a vertex within the thickness of a triangle lies in its box padded by the thickness; the boxes
   // are built once, so the pad holds another thickness for the pushes of the passes. Not the step's
-  // motion: a fast garment would make the cells, and every candidate list, as large as the piece
+  // motion: a fast garment would make the cells, and every candidate list, as large as the piece.
+  // The edges' boxes are padded by one thickness only, in cells of two mean edges (about two cells
+  // an axis a box): a pair coming within reach through the passes' pushes waits for the next step.
+  // The two grids are built at once, a thread each (a build is a serial counting sort)
   const float pad = 2.0f * thickness;
-  const float cell = std::max(edge / float(tris.size()), 2.0f * pad);
-  s.triangles.build<3>(tris, x1, cell, pad);
-  findPairs(tris, mesh.group, count, invMass, x0, x1, thickness, s);
-  // the edges' boxes padded by one thickness only, in cells of two mean edges (about two cells an
-  // axis a box): a pair coming within reach through the passes' pushes waits for the next step
-  s.edges.build<2>(edges, x1, 2.0f * edge / float(tris.size()), thickness);
-  findEdgePairs(mesh, invMass, x0, x1, thickness, s);
-  SelfCollisionPushes pushes;
-  for (int pass = 0; pass < kPasses; ++pass) {
-    for (const auto& [i, t] : s.pairs) {
-      const auto& tri = tris[t];
-      Four f({i, tri[0], tri[1], tri[2]}, x0, x1, vel, invMass);
-      if (!pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness)) continue;
-      f.store(x1, vel, s.moved);
-      ++pushes.vertexTriangle;
-    }
-    for (const auto& [a, b] : s.edgePairs) {
-      Four f({edges[a][0], edges[a][1], edges[b][0], edges[b][1]}, x0, x1, vel, invMass);
-      if (!pushEdgeOffEdge(f.x0, f.x1, f.v, f.w, thickness)) continue;
-      f.store(x1, vel, s.moved);
-      ++pushes.edgeEdge;
-    }
+#pragma omp parallel sections num_threads(std::min(2, omp_get_max_threads()))
+  {
+#pragma omp section
+    s.triangles.build<3>(tris, x1, std::max(edge / float(tris.size()), 2.0f * pad), pad);
+#pragma omp section
+    s.edges.build<2>(edges, x1, 2.0f * edge / float(tris.size()), thickness);
   }
-  return pushes;
+  findPairs(tris, mesh.group, count, invMass, x0, x1, thickness, s);
+  findEdgePairs(mesh, invMass, x0, x1, thickness, s);
+  return pushPairs(mesh, invMass, thickness, x0, x1, vel, s);
 }
 
 }  // namespace soak

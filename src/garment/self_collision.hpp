@@ -62,6 +62,7 @@ struct SelfCollisionScratch {
   std::vector<std::array<int, 2>> edgePairs;  // and (edge, edge), A < B
   std::vector<std::vector<std::array<int, 2>>> chunkPairs;  // per chunk of vertices or edges, joined into pairs
   std::vector<uint8_t> moved;                      // per vertex of the piece: pushed this step
+  std::vector<uint32_t> lastMove, testedAt;        // the passes' push counts: per vertex, per pair
 };
 
 // the push of one vertex against one triangle. x0, x1: the four points (vertex, then the triangle's

@@ -253,6 +253,10 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
     gs.selfEdgeContacts += static_cast<uint64_t>(r.selfEdgeContacts);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
+    stats.ms.part(StagePart::garmentAssemble) += r.msAssemble;
+    stats.ms.part(StagePart::garmentCg) += r.msCg;
+    stats.ms.part(StagePart::garmentIntegrate) += r.msIntegrate;
+    stats.ms.part(StagePart::garmentSelfContact) += r.msSelfContact;
   }
   if (!model.hasImplicitCloth()) return;
   // remember where the solve put the implicit cloth, so the coupling's push can become velocity

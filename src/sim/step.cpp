@@ -126,7 +126,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
   clock.lap(stats.ms.wetting);
   const DropCandidates paths{ws.coupling.candidateStart, ws.coupling.candidates};  // the coupling's, this substep
   stats.garment.dropsTaken += wetClothByContact(model, state, ws.neighbors, paths, ws.garment, ws.keep, state.time + h);
-  clock.lap(stats.ms.garment);                                                      // Chen 2012: wet by contact
+  clock.lap(stats.ms.garment, StagePart::garmentDrops);                             // Chen 2012: wet by contact
   stats.removedParticles += removeOutsideDomain(model, state, ws.keep);             // counted in the ledger
   clock.lap(stats.ms.velocities);
   state.time += h;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <set>
+#include <tuple>
 #include <numeric>
 
 namespace soak {
@@ -160,6 +161,45 @@ TEST(GarmentSelfCollision, SameResultForAnyThreadCount) {
   EXPECT_EQ(pushes1.edgeEdge, pushes2.edgeEdge);
   EXPECT_EQ(std::memcmp(a.xPred.data(), b.xPred.data(), n * sizeof(Vec3)), 0);
   EXPECT_EQ(std::memcmp(a.v.data(), b.v.data(), n * sizeof(Vec3)), 0);
+}
+
+// the passes skip a pair found clear until one of its points moves: the pushes are those of testing
+// every pair in every one of the three passes, in the same order (the reference below)
+TEST(GarmentSelfCollision, SkippingPairsThatDidNotMoveGivesTheSamePushes) {
+  const TwoSheets sheets = twoWavySheets();
+  const int n = sheets.n;
+  const SelfCollisionMesh mesh = buildSelfCollisionMesh(n, sheets.tris, {});
+  const std::vector<float> inv(n, 1.0f);
+  constexpr float kThickness = 0.008f;
+  Particles p = sheets.start;
+  SelfCollisionScratch s;
+  const SelfCollisionPushes pushes = selfCollide(mesh, 0, n, inv, kThickness, p, s);
+  Particles q = sheets.start;
+  int vertexTriangle = 0, edgeEdge = 0, later = 0;  // later: pushes after the first pass
+  const auto test = [&](const std::array<int, 4>& id, auto&& push) {
+    std::array<Vec3, 4> x0, x1, v;
+    std::array<float, 4> w;
+    for (int k = 0; k < 4; ++k) std::tie(x0[k], x1[k], v[k], w[k]) = std::tuple(q.x[id[k]], q.xPred[id[k]], q.v[id[k]], inv[id[k]]);
+    if (!push(x0, x1, v, w)) return 0;
+    for (int k = 0; k < 4; ++k) std::tie(q.xPred[id[k]], q.v[id[k]]) = std::tuple(x1[k], v[k]);
+    return 1;
+  };
+  for (int pass = 0; pass < 3; ++pass) {
+    const int before = vertexTriangle + edgeEdge;
+    for (const auto& [i, t] : s.pairs)
+      vertexTriangle += test({i, sheets.tris[t][0], sheets.tris[t][1], sheets.tris[t][2]}, [&](auto& x0, auto& x1, auto& v, auto& w) {
+        return pushVertexOffTriangle(x0, x1, v, w, kThickness);
+      });
+    for (const auto& [a, b] : s.edgePairs)
+      edgeEdge += test({mesh.edges[a][0], mesh.edges[a][1], mesh.edges[b][0], mesh.edges[b][1]},
+                       [&](auto& x0, auto& x1, auto& v, auto& w) { return pushEdgeOffEdge(x0, x1, v, w, kThickness); });
+    if (pass > 0) later += vertexTriangle + edgeEdge - before;
+  }
+  EXPECT_GT(later, 0);  // the later passes push too: the skipping is exercised
+  EXPECT_EQ(pushes.vertexTriangle, vertexTriangle);
+  EXPECT_EQ(pushes.edgeEdge, edgeEdge);
+  EXPECT_EQ(std::memcmp(p.xPred.data(), q.xPred.data(), n * sizeof(Vec3)), 0);
+  EXPECT_EQ(std::memcmp(p.v.data(), q.v.data(), n * sizeof(Vec3)), 0);
 }
 
 // the edges' closest points, p0 + s (p1 - p0) and q0 + t (q1 - q0), in double precision, when
