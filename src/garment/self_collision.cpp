@@ -271,6 +271,13 @@ struct Four {
   }
 };
 
+// whether the box [lo, hi] misses the entry's box: the six comparisons joined without branches (the
+// scans' hot test; the result is `(hi < en.lo).any() || (lo > en.hi).any()`)
+inline bool outsideBox(const Vec3& lo, const Vec3& hi, const BoxGrid::Entry& en) {
+  return (hi.x() < en.lo.x()) | (hi.y() < en.lo.y()) | (hi.z() < en.lo.z()) | (lo.x() > en.hi.x()) |
+         (lo.y() > en.hi.y()) | (lo.z() > en.hi.z());
+}
+
 // calls f(triangle) for every triangle whose padded box holds point q (those hashed into q's cell)
 template <typename F>
 void forTrianglesAt(const Vec3& q, const BoxGrid& g, F&& f) {
@@ -278,7 +285,7 @@ void forTrianglesAt(const Vec3& q, const BoxGrid& g, F&& f) {
                               static_cast<int>(std::floor(q.z() / g.cell)));
   for (uint32_t e = g.bucketStart[b]; e < g.bucketStart[b + 1]; ++e) {
     const BoxGrid::Entry& en = g.entry[e];
-    if ((q.array() < en.lo.array()).any() || (q.array() > en.hi.array()).any()) continue;
+    if (outsideBox(q, q, en)) continue;
     f(en.id);
   }
 }
@@ -304,7 +311,7 @@ void forEdgesMeeting(size_t i, const BoxGrid& g, F&& f) {
         for (auto e = after; e != end; ++e) {
           const int j = e->id;
           if (e != after && (e - 1)->id == j) continue;
-          if ((hi.array() < e->lo.array()).any() || (lo.array() > e->hi.array()).any()) continue;
+          if (outsideBox(lo, hi, *e)) continue;
           const auto& jl = g.cellLo[j];
           if (ci != std::max(cLo[0], jl[0]) || cj != std::max(cLo[1], jl[1]) || ck != std::max(cLo[2], jl[2])) continue;
           f(j);
