@@ -49,12 +49,13 @@ struct GarmentStats {
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)
   uint64_t selfContacts = 0;    // vertex-triangle pushes of an implicit piece's self-collision
   uint64_t selfEdgeContacts = 0;  // and its edge-edge pushes
+  uint64_t selfReverted = 0;    // vertices its fail-safe put back to their start (docs/garment.md, "Self-collision")
   uint64_t disturbances = 0;    // wrinkle constraints applied (section 3.5)
   uint64_t dropsTaken = 0;      // water particles that wetted a piece and vanished into it
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; selfReverted += o.selfReverted; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     return *this;
   }
 };

@@ -461,7 +461,7 @@ SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g,
     w.invMass[v] = (w.constrained[v] == 1 || w.constrained[v] == 2) ? 0.0f : 1.0f / p.mass[first + v];
   const float thickness = model.pieces[static_cast<size_t>(g.piece)].material.thickness;
   const SelfCollisionPushes pushes = selfCollide(g.mesh, g.firstParticle, g.count, w.invMass, thickness, p, w.self);
-  if (pushes.vertexTriangle + pushes.edgeEdge == 0) return pushes;
+  if (pushes.vertexTriangle + pushes.edgeEdge + pushes.reverted == 0) return pushes;
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   for (int v = 0; v < g.count; ++v) {
@@ -524,6 +524,7 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
     const SelfCollisionPushes pushes = selfCollisionStep(model, g, poses, p, w);
     stats.selfContacts = pushes.vertexTriangle;
     stats.selfEdgeContacts = pushes.edgeEdge;
+    stats.selfReverted = pushes.reverted;
   }
   lap(clock, stats.msSelfContact);
   for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 
 namespace soak {
 
@@ -33,6 +34,27 @@ bool crossedInside(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1,
     if ((u - xs[0]).cross(t - xs[0]).dot(nraw) / area2 < -kCrossingSlack) return false;
   }
   return true;
+}
+
+// the unit normals of a test's plane at the start and the end (the triangle's, or the two edges'
+// common one), when both are well defined and turned by less than 60 degrees in the step
+bool stepNormals(const Vec3& n0raw, const Vec3& n1raw, float minRaw2, Vec3& n0, Vec3& n1) {
+  if (!(n0raw.squaredNorm() > minRaw2) || !(n1raw.squaredNorm() > minRaw2)) return false;
+  n0 = n0raw.normalized();
+  n1 = n1raw.normalized();
+  return n0.dot(n1) >= 0.5f;
+}
+
+// whether the vertex went through the triangle during the step: from one side of its plane to the
+// other, crossing it inside the triangle (crossedInside), the triangle turning by less than 60
+// degrees (as pushVertexOffTriangle: a flipped triangle has no side)
+bool passedThrough(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1) {
+  const Vec3 n0raw = (x0[2] - x0[1]).cross(x0[3] - x0[1]), n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
+  if (!((x0[0] - x0[1]).dot(n0raw) * (x1[0] - x1[1]).dot(n1raw) < 0.0f)) return false;  // the same side: the common case
+  Vec3 n0, n1;
+  if (!stepNormals(n0raw, n1raw, 1e-24f, n0, n1)) return false;
+  const float dist0 = (x0[0] - x0[1]).dot(n0), dist1 = (x1[0] - x1[1]).dot(n1);
+  return dist0 * dist1 < 0.0f && crossedInside(x0, x1, dist0, dist1);
 }
 
 // the common case, without a square root: the vertex is on the same side of the triangle's plane at
@@ -173,6 +195,25 @@ bool edgesCrossed(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, 
   return within(s) && within(t);
 }
 
+// whether the edges crossed from one side of each other to the other during the step, their lines'
+// closest points inside both at that moment (as edgesCrossed; not where they were within about 6
+// degrees of parallel at the start, the end or the crossing, whose sides are noise)
+bool edgesPassedThrough(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1) {
+  const Vec3 e0a = x0[1] - x0[0], e0b = x0[3] - x0[2], e1a = x1[1] - x1[0], e1b = x1[3] - x1[2];
+  const Vec3 n0raw = e0a.cross(e0b), n1raw = e1a.cross(e1b);
+  if (!((x0[2] - x0[0]).dot(n0raw) * (x1[2] - x1[0]).dot(n1raw) < 0.0f)) return false;  // the same side: the common case
+  Vec3 n0, n1;
+  const float minRaw2 = 0.01f * std::min(e0a.squaredNorm() * e0b.squaredNorm(), e1a.squaredNorm() * e1b.squaredNorm());
+  if (!stepNormals(n0raw, n1raw, std::max(minRaw2, 1e-24f), n0, n1)) return false;
+  const float dist0 = (x0[2] - x0[0]).dot(n0), dist1 = (x1[2] - x1[0]).dot(n1);
+  if (!(dist0 * dist1 < 0.0f)) return false;
+  const float f = dist0 / (dist0 - dist1);
+  std::array<Vec3, 4> xs;
+  for (int k = 0; k < 4; ++k) xs[k] = x0[k] + f * (x1[k] - x0[k]);
+  float s, t;
+  return closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t) && s >= 0.0f && s <= 1.0f && t >= 0.0f && t <= 1.0f;
+}
+
 }  // namespace
 
 bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
@@ -216,7 +257,8 @@ void BoxGrid::forCells(size_t t, F&& f) const {
 
 // hashes every primitive into the cells its end-of-step box, padded by `pad`, overlaps (counting sort)
 template <size_t K>
-void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3* x1, float cellSize, float padding) {
+void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3* x0, const Vec3* x1, float cellSize,
+                    float padding) {
   const size_t np = prims.size();
   cell = cellSize;
   pad = padding;
@@ -227,9 +269,9 @@ void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3*
   bucketStart.assign((1u << kBucketBits) + 1, 0);
   for (size_t t = 0; t < np; ++t) {
     Vec3 lo = x1[prims[t][0]], hi = lo;
-    for (size_t k = 1; k < K; ++k) {
-      lo = lo.cwiseMin(x1[prims[t][k]]);
-      hi = hi.cwiseMax(x1[prims[t][k]]);
+    for (size_t k = 0; k < K; ++k) {  // the primitive's sweep: its points at the start and the end
+      lo = lo.cwiseMin(x1[prims[t][k]]).cwiseMin(x0[prims[t][k]]);
+      hi = hi.cwiseMax(x1[prims[t][k]]).cwiseMax(x0[prims[t][k]]);
     }
     boxLo[t] = lo - Vec3::Constant(pad);
     boxHi[t] = hi + Vec3::Constant(pad);
@@ -278,16 +320,32 @@ inline bool outsideBox(const Vec3& lo, const Vec3& hi, const BoxGrid::Entry& en)
          (lo.y() > en.hi.y()) | (lo.z() > en.hi.z());
 }
 
-// calls f(triangle) for every triangle whose padded box holds point q (those hashed into q's cell)
-template <typename F>
-void forTrianglesAt(const Vec3& q, const BoxGrid& g, F&& f) {
-  const uint32_t b = bucketOf(static_cast<int>(std::floor(q.x() / g.cell)), static_cast<int>(std::floor(q.y() / g.cell)),
-                              static_cast<int>(std::floor(q.z() / g.cell)));
-  for (uint32_t e = g.bucketStart[b]; e < g.bucketStart[b + 1]; ++e) {
-    const BoxGrid::Entry& en = g.entry[e];
-    if (outsideBox(q, q, en)) continue;
-    f(en.id);
+// the cells [cLo, cHi] of the box [lo, hi]
+void cellsOf(const Vec3& lo, const Vec3& hi, float cell, std::array<int, 3>& cLo, std::array<int, 3>& cHi) {
+  for (int a = 0; a < 3; ++a) {
+    cLo[a] = static_cast<int>(std::floor(lo[a] / cell));
+    cHi[a] = static_cast<int>(std::floor(hi[a] / cell));
   }
+}
+
+// calls f(triangle) once for every triangle whose padded box overlaps the box [lo, hi] (a vertex's
+// sweep): met in every cell both share, counted in the first (the lowest in each axis)
+template <typename F>
+void forTrianglesMeeting(const Vec3& lo, const Vec3& hi, const BoxGrid& g, F&& f) {
+  std::array<int, 3> cLo, cHi;
+  cellsOf(lo, hi, g.cell, cLo, cHi);
+  for (int ci = cLo[0]; ci <= cHi[0]; ++ci)
+    for (int cj = cLo[1]; cj <= cHi[1]; ++cj)
+      for (int ck = cLo[2]; ck <= cHi[2]; ++ck) {
+        const uint32_t b = bucketOf(ci, cj, ck);
+        for (uint32_t e = g.bucketStart[b]; e < g.bucketStart[b + 1]; ++e) {
+          const BoxGrid::Entry& en = g.entry[e];
+          if (outsideBox(lo, hi, en)) continue;
+          const auto& tl = g.cellLo[en.id];
+          if (ci != std::max(cLo[0], tl[0]) || cj != std::max(cLo[1], tl[1]) || ck != std::max(cLo[2], tl[2])) continue;
+          f(en.id);
+        }
+      }
 }
 
 // calls f(j) once for every edge j after edge i whose padded box overlaps i's own (unpadded) box: j
@@ -297,10 +355,7 @@ template <typename F>
 void forEdgesMeeting(size_t i, const BoxGrid& g, F&& f) {
   const Vec3 lo = g.boxLo[i] + Vec3::Constant(g.pad), hi = g.boxHi[i] - Vec3::Constant(g.pad);
   std::array<int, 3> cLo, cHi;
-  for (int a = 0; a < 3; ++a) {
-    cLo[a] = static_cast<int>(std::floor(lo[a] / g.cell));
-    cHi[a] = static_cast<int>(std::floor(hi[a] / g.cell));
-  }
+  cellsOf(lo, hi, g.cell, cLo, cHi);
   for (int ci = cLo[0]; ci <= cHi[0]; ++ci)
     for (int cj = cLo[1]; cj <= cHi[1]; ++cj)
       for (int ck = cLo[2]; ck <= cHi[2]; ++ck) {
@@ -355,12 +410,17 @@ void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<in
                const int end = static_cast<int>(std::min<int64_t>(count, (c + 1) * kChunk));
                for (int i = static_cast<int>(c * kChunk); i < end; ++i) {
                  if (invMass[i] == 0.0f) continue;
-                 forTrianglesAt(x1[i], s.triangles, [&](int t) {
+                 // its sweep; a vertex that moved less than the pad meets every triangle it could pass
+                 // through at its end already (the point it passed lies in the triangle's sweep)
+                 const bool slow = (x1[i] - x0[i]).cwiseAbs().maxCoeff() <= s.triangles.pad;
+                 const Vec3 lo = slow ? x1[i] : x0[i].cwiseMin(x1[i]), hi = slow ? x1[i] : x0[i].cwiseMax(x1[i]);
+                 forTrianglesMeeting(lo, hi, s.triangles, [&](int t) {
                    const auto& tri = tris[t];
                    if (group[tri[0]] == group[i] || group[tri[1]] == group[i] || group[tri[2]] == group[i]) return;
                    const std::array<Vec3, 4> a0{x0[i], x0[tri[0]], x0[tri[1]], x0[tri[2]]};
                    const std::array<Vec3, 4> a1{x1[i], x1[tri[0]], x1[tri[1]], x1[tri[2]]};
-                   if (!clearOnItsSide(a0, a1, near) && projectsNear(a1, outside)) out.push_back({i, t});
+                   if ((!clearOnItsSide(a0, a1, near) && projectsNear(a1, outside)) || passedThrough(a0, a1))
+                     out.push_back({i, t});
                  });
                }
              });
@@ -403,7 +463,8 @@ void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invM
                    if (gc == ga || gc == gb || gd == ga || gd == gb) return;
                    const std::array<Vec3, 4> a0{x0[ea[0]], x0[ea[1]], x0[eb[0]], x0[eb[1]]};
                    const std::array<Vec3, 4> a1{x1[ea[0]], x1[ea[1]], x1[eb[0]], x1[eb[1]]};
-                   if (edgesApart(a0, a1, near, outside) || mesh.neighbours(ga, gc) || mesh.neighbours(ga, gd) ||
+                   if ((edgesApart(a0, a1, near, outside) && !edgesPassedThrough(a0, a1)) || mesh.neighbours(ga, gc) ||
+                       mesh.neighbours(ga, gd) ||
                        mesh.neighbours(gb, gc) || mesh.neighbours(gb, gd))
                      return;
                    out.push_back({int(i), j});
@@ -464,6 +525,89 @@ SelfCollisionPushes pushPairs(const SelfCollisionMesh& mesh, const std::vector<f
 
 }  // namespace
 
+namespace {
+
+constexpr int kZoneRounds = 8;  // at most; a round joins every pair still through into the zones
+
+// the fail-safe, rigid impact zones in translation (after Bridson, Fedkiw and Anderson 2002): the
+// free points of a pair still through each other after the passes (a push closes at most a thickness,
+// and a vertex that went far through ends far) join one zone, and every zone's free points take its
+// mass-weighted mean displacement over the step and mean velocity, so the pair keeps the shape it
+// started the step with (and its side) while the zone keeps its momentum; zones sharing a point merge,
+// and the pairs are tested again until none is through. The pairs are those found for the step's
+// motion, whose sweeps a zone's common motion keeps within the boxes for the most part. Returns the
+// points moved into zones
+int impactZones(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, const Vec3* x0, Vec3* x1,
+                Vec3* vel, SelfCollisionScratch& s) {
+  const auto through = [&](const std::array<int, 4>& id, bool vertexTriangle) {
+    std::array<Vec3, 4> a0, a1;
+    for (int k = 0; k < 4; ++k) std::tie(a0[k], a1[k]) = std::pair(x0[id[k]], x1[id[k]]);
+    return vertexTriangle ? passedThrough(a0, a1) : edgesPassedThrough(a0, a1);
+  };
+  const auto pairIds = [&](size_t k) -> std::array<int, 4> {
+    if (k < s.pairs.size()) {
+      const auto& tri = mesh.triangles[s.pairs[k][1]];
+      return {s.pairs[k][0], tri[0], tri[1], tri[2]};
+    }
+    const auto& [a, b] = s.edgePairs[k - s.pairs.size()];
+    return {mesh.edges[a][0], mesh.edges[a][1], mesh.edges[b][0], mesh.edges[b][1]};
+  };
+  const size_t pairs = s.pairs.size() + s.edgePairs.size();
+  std::vector<int>& zone = s.zone;  // union-find over the points; -1: in no zone
+  zone.assign(s.moved.size(), -1);
+  std::vector<int> members;  // the points in zones, with their motion before the zones
+  std::vector<std::pair<Vec3, Vec3>>& before = s.zoneMotion;
+  const auto root = [&](int v) {
+    while (zone[v] != v) v = zone[v] = zone[zone[v]];
+    return v;
+  };
+  for (int round = 0; round < kZoneRounds; ++round) {
+    bool joined = false;
+    for (size_t k = 0; k < pairs; ++k) {
+      const std::array<int, 4> id = pairIds(k);
+      if (!through(id, k < s.pairs.size())) continue;
+      int r = -1;
+      for (int v : id) {
+        if (invMass[v] == 0.0f) continue;
+        if (zone[v] < 0) {
+          zone[v] = v;
+          members.push_back(v);
+          before.resize(static_cast<size_t>(v) + 1 > before.size() ? static_cast<size_t>(v) + 1 : before.size());
+          before[v] = {x1[v] - x0[v], vel[v]};
+        }
+        const int rv = root(v);
+        if (r >= 0 && rv != r) zone[std::max(rv, r)] = std::min(rv, r);
+        r = r < 0 ? rv : std::min(rv, r);
+        joined = true;
+      }
+    }
+    if (!joined) break;
+    // each zone's mean displacement and velocity, weighted by mass, from its points' own motion
+    std::vector<Vec3>& sum = s.zoneSum;
+    std::vector<Vec3>& sumV = s.zoneSumV;
+    std::vector<float>& mass = s.zoneMass;
+    sum.assign(s.moved.size(), Vec3::Zero());
+    sumV.assign(s.moved.size(), Vec3::Zero());
+    mass.assign(s.moved.size(), 0.0f);
+    for (int v : members) {
+      const int r = root(v);
+      const float m = 1.0f / invMass[v];
+      sum[r] += m * before[v].first;
+      sumV[r] += m * before[v].second;
+      mass[r] += m;
+    }
+    for (int v : members) {
+      const int r = root(v);
+      x1[v] = x0[v] + sum[r] / mass[r];
+      vel[v] = sumV[r] / mass[r];
+      s.moved[v] = 1;
+    }
+  }
+  return static_cast<int>(members.size());
+}
+
+}  // namespace
+
 SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass,
                                 float thickness, Particles& p, SelfCollisionScratch& s) {
   const auto& tris = mesh.triangles;
@@ -485,13 +629,15 @@ SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int co
 #pragma omp parallel sections num_threads(std::min(2, omp_get_max_threads()))
   {
 #pragma omp section
-    s.triangles.build<3>(tris, x1, std::max(edge / float(tris.size()), 2.0f * pad), pad);
+    s.triangles.build<3>(tris, x0, x1, std::max(edge / float(tris.size()), 2.0f * pad), pad);
 #pragma omp section
-    s.edges.build<2>(edges, x1, 2.0f * edge / float(tris.size()), thickness);
+    s.edges.build<2>(edges, x0, x1, 2.0f * edge / float(tris.size()), thickness);
   }
   findPairs(tris, mesh.group, count, invMass, x0, x1, thickness, s);
   findEdgePairs(mesh, invMass, x0, x1, thickness, s);
-  return pushPairs(mesh, invMass, thickness, x0, x1, vel, s);
+  SelfCollisionPushes pushes = pushPairs(mesh, invMass, thickness, x0, x1, vel, s);
+  pushes.reverted = impactZones(mesh, invMass, x0, x1, vel, s);
+  return pushes;
 }
 
 }  // namespace soak

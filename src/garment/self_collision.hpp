@@ -6,9 +6,11 @@
 // start-of-step side, after Bridson, Fedkiw and Anderson 2002); one that went round the triangle's
 // or the edge's end keeps its new side, and a push closes at most one thickness. The push is shared
 // by the four points by inverse mass and barycentric weight (momentum is kept), and their velocity
-// towards each other along the normal is removed (inelastic). The pairs within reach are found once
-// per step, by chunks in parallel joined in order; the passes are Gauss-Seidel over those pairs,
-// vertex-triangle then edge-edge, serial: the result does not depend on the thread count.
+// towards each other along the normal is removed (inelastic). The pairs within reach, or that passed
+// through each other during the step however fast (each primitive's box covers its sweep), are found
+// once per step, by chunks in parallel joined in order; the passes are Gauss-Seidel over those pairs,
+// vertex-triangle then edge-edge, serial: the result does not depend on the thread count. A pair still
+// through each other after them has its free points put back to their start, at rest (the fail-safe).
 #pragma once
 #include <soak/math.hpp>
 #include <soak/model.hpp>
@@ -17,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace soak {
@@ -37,7 +40,8 @@ struct SelfCollisionMesh {
 SelfCollisionMesh buildSelfCollisionMesh(int count, std::vector<std::array<int, 3>> tris,
                                          const std::vector<std::array<int, 2>>& seams);
 
-// a hashed grid of the padded end-of-step boxes of a piece's triangles or edges
+// a hashed grid of the padded boxes of a piece's triangles or edges, each over its points at the start
+// and the end of the step (its sweep)
 struct BoxGrid {
   float cell = 1.0f;                  // m
   float pad = 0.0f;                   // m
@@ -51,7 +55,7 @@ struct BoxGrid {
   std::vector<std::array<int, 3>> cellLo, cellHi;  // each primitive's cell range
   std::vector<Vec3> boxLo, boxHi;                  // each primitive's padded box
   template <size_t K>
-  void build(std::span<const std::array<int, K>> prims, const Vec3* x1, float cellSize, float padding);
+  void build(std::span<const std::array<int, K>> prims, const Vec3* x0, const Vec3* x1, float cellSize, float padding);
   template <typename F>
   void forCells(size_t t, F&& f) const;  // f(bucket) for every cell of primitive t
 };
@@ -63,6 +67,10 @@ struct SelfCollisionScratch {
   std::vector<std::vector<std::array<int, 2>>> chunkPairs;  // per chunk of vertices or edges, joined into pairs
   std::vector<uint8_t> moved;                      // per vertex of the piece: pushed this step
   std::vector<uint32_t> lastMove, testedAt;        // the passes' push counts: per vertex, per pair
+  std::vector<int> zone;                           // the fail-safe's impact zones (union-find), -1 none
+  std::vector<std::pair<Vec3, Vec3>> zoneMotion;   // per point in a zone: its displacement and velocity before
+  std::vector<Vec3> zoneSum, zoneSumV;             // per zone root: mass-weighted sums
+  std::vector<float> zoneMass;
 };
 
 // the push of one vertex against one triangle. x0, x1: the four points (vertex, then the triangle's
@@ -84,10 +92,11 @@ bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std
 // within its reach, then every edge against the edges within its reach. A triangle holding the vertex's seam group
 // is not tested, nor an edge pair that shares a group or whose groups share a triangle (two sides of one fold:
 // a crossing between them is a vertex's through a triangle). Inverse masses `invMass` (0: pinned or disturbed).
-// Positions p.x (start) and p.xPred (end), velocities p.v. Marks the vertices it moved in s.moved. Returns the
-// pushes made of each kind.
+// Positions p.x (start) and p.xPred (end), velocities p.v. Then the fail-safe. Marks the vertices it moved in
+// s.moved. Returns the pushes made of each kind and the points the fail-safe put back.
 struct SelfCollisionPushes {
   int vertexTriangle = 0, edgeEdge = 0;
+  int reverted = 0;  // points put back to their start by the fail-safe (a pair still through each other)
 };
 SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass,
                                 float thickness, Particles& p, SelfCollisionScratch& s);

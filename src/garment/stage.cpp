@@ -252,6 +252,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
     gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
     gs.selfEdgeContacts += static_cast<uint64_t>(r.selfEdgeContacts);
+    gs.selfReverted += static_cast<uint64_t>(r.selfReverted);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
     stats.ms.part(StagePart::garmentAssemble) += r.msAssemble;
     stats.ms.part(StagePart::garmentCg) += r.msCg;

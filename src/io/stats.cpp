@@ -92,6 +92,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"edgeContacts", g.edgeContacts},
                     {"selfContacts", g.selfContacts},
                     {"selfEdgeContacts", g.selfEdgeContacts},
+                    {"selfReverted", g.selfReverted},
                     {"disturbances", g.disturbances},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},

@@ -106,6 +106,30 @@ TEST(GarmentSelfCollision, ASheetDroppedOnAnotherStaysOnIt) {
     if (p.xPred[i].x() < 1.0f && p.xPred[i].y() < 1.0f) EXPECT_GT(p.xPred[i].z(), 0.0f) << i;
 }
 
+// a vertex that went through a triangle and 20 cm beyond in one step (far past the boxes' pads: a fast
+// fold) is found by its sweep; the pushes close a thickness each, so the fail-safe's impact zone takes
+// over: the four points move together by their mean displacement, the vertex stays above, momentum kept
+TEST(GarmentSelfCollision, AVertexThatWentFarThroughInOneStepEndsOnItsSide) {
+  Particles p;
+  for (const Vec3& x : startAbove(0.02f)) p.add(1, 0, 1.0f, 0.01f, x, Vec3::Zero());
+  p.v[0] = Vec3(0, 0, -13.2f);  // 22 cm in 1/60 s
+  p.xPred = p.x;
+  p.xPred[0].z() = -0.2f;
+  const std::vector<float> inv(4, 1.0f);
+  Vec3 momentum0 = Vec3::Zero(), shift0 = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) std::tie(momentum0, shift0) = std::pair(momentum0 + p.v[k], shift0 + (p.xPred[k] - p.x[k]));
+  SelfCollisionScratch s;
+  const SelfCollisionPushes pushes = selfCollide(buildSelfCollisionMesh(4, {{1, 2, 3}}, {}), 0, 4, inv, 0.008f, p, s);
+  ASSERT_EQ(s.pairs.size(), 1u);  // found through its sweep
+  EXPECT_EQ(pushes.reverted, 4);
+  const std::array<Vec3, 4> end{p.xPred[0], p.xPred[1], p.xPred[2], p.xPred[3]};
+  EXPECT_NEAR(aboveTriangle(end), 0.02f, 1e-6f);  // the shape it started the step with
+  Vec3 momentum = Vec3::Zero(), shift = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) std::tie(momentum, shift) = std::pair(momentum + p.v[k], shift + (p.xPred[k] - p.x[k]));
+  EXPECT_NEAR((momentum - momentum0).norm(), 0.0f, 1e-5f);
+  EXPECT_NEAR((shift - shift0).norm(), 0.0f, 1e-5f);  // the zone moves by the points' mean displacement
+}
+
 // two 20 x 20 sheets of one piece, 1 cm apart and wavy, the upper moved 2 cm down through the lower
 struct TwoSheets {
   Particles start;
@@ -334,6 +358,29 @@ TEST(GarmentSelfCollision, StripsCrossingOnlyAtTheirEdgesAreKeptApart) {
   EXPECT_EQ(crossings(p), 0u);
   const auto middleHeight = [&](int a, int b) { return 0.5f * (p.xPred[a].z() + p.xPred[b].z()); };
   EXPECT_GT(middleHeight(4, 7), middleHeight(0, 3));  // the upper strip's middle is back over the lower's
+}
+
+// the strips of the test above, the upper one's end moved 40 cm down in one step: its middle passes
+// 20 cm through the lower strip, far past the pads, and only their edges meet. The edge-edge sweep
+// finds them and the fail-safe keeps the upper strip's middle over the lower (where it started)
+TEST(GarmentSelfCollision, StripsPassingFarThroughEachOtherInOneStepKeepTheirSides) {
+  Particles p;
+  for (float y : {-0.01f, 0.01f})
+    for (float x : {-0.5f, 0.5f}) p.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0), Vec3::Zero());
+  for (float y : {-0.5f, 0.5f})
+    for (float x : {-0.01f, 0.01f}) p.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0.01f), Vec3(0, 0, -12));
+  p.xPred = p.x;
+  for (int i = 4; i < 6; ++i) p.xPred[i].z() -= 0.4f;
+  const auto middleHeight = [&](int a, int b) { return 0.5f * (p.xPred[a].z() + p.xPred[b].z()); };
+  ASSERT_LT(middleHeight(4, 7), middleHeight(0, 3) - 0.1f);  // the upper strip's middle ends 20 cm under
+  const std::vector<std::array<int, 3>> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
+  SelfCollisionScratch s;
+  const SelfCollisionPushes pushes =
+      selfCollide(buildSelfCollisionMesh(8, tris, {}), 0, 8, std::vector<float>(8, 1.0f), 0.008f, p, s);
+  EXPECT_GT(s.edgePairs.size(), 0u);
+  EXPECT_EQ(pushes.reverted, 8);  // every point joins the zone
+  EXPECT_GT(middleHeight(4, 7), middleHeight(0, 3));
+  EXPECT_EQ(testing::countCrossingTriangles(p.xPred, tris), 0u);
 }
 
 }  // namespace
