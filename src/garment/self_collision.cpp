@@ -2,12 +2,12 @@
 #include "garment/self_collision.hpp"
 
 #include "core/parallel.hpp"
+#include "garment/self_collision_resolve.hpp"
 #include "world/mesh.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <tuple>
 
 namespace soak {
 
@@ -36,6 +36,16 @@ bool crossedInside(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1,
   return true;
 }
 
+// the common case, without a square root: the vertex is on the same side of the triangle's plane at
+// the start and the end, and at least d from it at the end
+bool clearOnItsSide(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float d) {
+  const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
+  const float dist1raw = (x1[0] - x1[1]).dot(n1raw);  // dist1 |n1raw|
+  const Vec3 n0raw = (x0[2] - x0[1]).cross(x0[3] - x0[1]);
+  const float dist0raw = (x0[0] - x0[1]).dot(n0raw);
+  return n0raw.squaredNorm() > 1e-24f && dist0raw * dist1raw > 0.0f && dist1raw * dist1raw >= d * d * n1raw.squaredNorm();
+}
+
 // the unit normals of a test's plane at the start and the end (the triangle's, or the two edges'
 // common one), when both are well defined and turned by less than 60 degrees in the step
 bool stepNormals(const Vec3& n0raw, const Vec3& n1raw, float minRaw2, Vec3& n0, Vec3& n1) {
@@ -44,6 +54,8 @@ bool stepNormals(const Vec3& n0raw, const Vec3& n1raw, float minRaw2, Vec3& n0, 
   n1 = n1raw.normalized();
   return n0.dot(n1) >= 0.5f;
 }
+
+}  // namespace
 
 // whether the vertex went through the triangle during the step: from one side of its plane to the
 // other, crossing it inside the triangle (crossedInside), the triangle turning by less than 60
@@ -56,18 +68,6 @@ bool passedThrough(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1)
   const float dist0 = (x0[0] - x0[1]).dot(n0), dist1 = (x1[0] - x1[1]).dot(n1);
   return dist0 * dist1 < 0.0f && crossedInside(x0, x1, dist0, dist1);
 }
-
-// the common case, without a square root: the vertex is on the same side of the triangle's plane at
-// the start and the end, and at least d from it at the end
-bool clearOnItsSide(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float d) {
-  const Vec3 n1raw = (x1[2] - x1[1]).cross(x1[3] - x1[1]);
-  const float dist1raw = (x1[0] - x1[1]).dot(n1raw);  // dist1 |n1raw|
-  const Vec3 n0raw = (x0[2] - x0[1]).cross(x0[3] - x0[1]);
-  const float dist0raw = (x0[0] - x0[1]).dot(n0raw);
-  return n0raw.squaredNorm() > 1e-24f && dist0raw * dist1raw > 0.0f && dist1raw * dist1raw >= d * d * n1raw.squaredNorm();
-}
-
-}  // namespace
 
 SelfCollisionMesh buildSelfCollisionMesh(int count, std::vector<std::array<int, 3>> tris,
                                          const std::vector<std::array<int, 2>>& seams) {
@@ -195,6 +195,8 @@ bool edgesCrossed(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, 
   return within(s) && within(t);
 }
 
+}  // namespace
+
 // whether the edges crossed from one side of each other to the other during the step, their lines'
 // closest points inside both at that moment (as edgesCrossed; not where they were within about 6
 // degrees of parallel at the start, the end or the crossing, whose sides are noise)
@@ -213,8 +215,6 @@ bool edgesPassedThrough(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>
   float s, t;
   return closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t) && s >= 0.0f && s <= 1.0f && t >= 0.0f && t <= 1.0f;
 }
-
-}  // namespace
 
 bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,
                      const std::array<float, 4>& w, float d) {
@@ -239,7 +239,6 @@ bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std
 namespace {
 
 constexpr uint32_t kBucketBits = 16;
-constexpr int kPasses = 3;  // Gauss-Seidel passes: a push can undo an earlier one nearby
 
 uint32_t bucketOf(int64_t i, int64_t j, int64_t k) {
   const uint64_t h = uint64_t(i) * 73856093ULL ^ uint64_t(j) * 19349663ULL ^ uint64_t(k) * 83492791ULL;
@@ -290,28 +289,6 @@ void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3*
 
 namespace {
 
-// the four particles of one test (ids local to the piece), gathered and written back
-struct Four {
-  std::array<int, 4> id;
-  std::array<Vec3, 4> x0, x1, v;
-  std::array<float, 4> w;
-  Four(const std::array<int, 4>& ids, const Vec3* x0s, const Vec3* x1s, const Vec3* vs, const std::vector<float>& inv)
-      : id(ids) {
-    for (int k = 0; k < 4; ++k) {
-      x0[k] = x0s[id[k]];
-      x1[k] = x1s[id[k]];
-      v[k] = vs[id[k]];
-      w[k] = inv[id[k]];
-    }
-  }
-  void store(Vec3* x1s, Vec3* vs, std::vector<uint8_t>& moved) const {
-    for (int k = 0; k < 4; ++k) {
-      x1s[id[k]] = x1[k];
-      vs[id[k]] = v[k];
-      moved[id[k]] = 1;
-    }
-  }
-};
 
 // whether the box [lo, hi] misses the entry's box: the six comparisons joined without branches (the
 // scans' hot test; the result is `(hi < en.lo).any() || (lo > en.hi).any()`)
@@ -474,136 +451,6 @@ void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invM
   s.edgePairs.clear();
   for (int64_t c = 0; c < chunks; ++c)
     s.edgePairs.insert(s.edgePairs.end(), s.chunkPairs[c].begin(), s.chunkPairs[c].end());
-}
-
-}  // namespace
-
-namespace {
-
-// whether none of a test's four points moved since the push counter stood at `tested`
-bool unmovedSince(const std::array<int, 4>& id, const std::vector<uint32_t>& lastMove, uint32_t tested) {
-  return lastMove[id[0]] <= tested && lastMove[id[1]] <= tested && lastMove[id[2]] <= tested && lastMove[id[3]] <= tested;
-}
-
-// kPasses Gauss-Seidel passes over the step's pairs, vertex-triangle then edge-edge. A test reads only
-// its four points' end positions (their start positions and masses are constant), so a pair found
-// clear is skipped until one of its points moves: the same pushes as testing every pair every pass
-SelfCollisionPushes pushPairs(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, float thickness,
-                              const Vec3* x0, Vec3* x1, Vec3* vel, SelfCollisionScratch& s) {
-  const auto& tris = mesh.triangles;
-  const auto& edges = mesh.edges;
-  uint32_t pushed = 0;  // pushes so far; lastMove[v] = the count after v's last push
-  s.lastMove.assign(s.moved.size(), 0);
-  s.testedAt.assign(s.pairs.size() + s.edgePairs.size(), 0);
-  const auto test = [&](size_t k, const std::array<int, 4>& id, bool pass0, auto&& push) {
-    if (!pass0 && unmovedSince(id, s.lastMove, s.testedAt[k])) return false;
-    s.testedAt[k] = pushed;
-    Four f(id, x0, x1, vel, invMass);
-    if (!push(f)) return false;
-    f.store(x1, vel, s.moved);
-    ++pushed;
-    for (int v : id) s.lastMove[v] = pushed;
-    return true;
-  };
-  SelfCollisionPushes pushes;
-  for (int pass = 0; pass < kPasses; ++pass) {
-    for (size_t k = 0; k < s.pairs.size(); ++k) {
-      const auto& [i, t] = s.pairs[k];
-      const auto& tri = tris[t];
-      pushes.vertexTriangle += test(k, {i, tri[0], tri[1], tri[2]}, pass == 0, [&](Four& f) {
-        return pushVertexOffTriangle(f.x0, f.x1, f.v, f.w, thickness);
-      });
-    }
-    for (size_t k = 0; k < s.edgePairs.size(); ++k) {
-      const auto& [a, b] = s.edgePairs[k];
-      pushes.edgeEdge += test(s.pairs.size() + k, {edges[a][0], edges[a][1], edges[b][0], edges[b][1]}, pass == 0,
-                              [&](Four& f) { return pushEdgeOffEdge(f.x0, f.x1, f.v, f.w, thickness); });
-    }
-  }
-  return pushes;
-}
-
-}  // namespace
-
-namespace {
-
-constexpr int kZoneRounds = 8;  // at most; a round joins every pair still through into the zones
-
-// the fail-safe, rigid impact zones in translation (after Bridson, Fedkiw and Anderson 2002): the
-// free points of a pair still through each other after the passes (a push closes at most a thickness,
-// and a vertex that went far through ends far) join one zone, and every zone's free points take its
-// mass-weighted mean displacement over the step and mean velocity, so the pair keeps the shape it
-// started the step with (and its side) while the zone keeps its momentum; zones sharing a point merge,
-// and the pairs are tested again until none is through. The pairs are those found for the step's
-// motion, whose sweeps a zone's common motion keeps within the boxes for the most part. Returns the
-// points moved into zones
-int impactZones(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, const Vec3* x0, Vec3* x1,
-                Vec3* vel, SelfCollisionScratch& s) {
-  const auto through = [&](const std::array<int, 4>& id, bool vertexTriangle) {
-    std::array<Vec3, 4> a0, a1;
-    for (int k = 0; k < 4; ++k) std::tie(a0[k], a1[k]) = std::pair(x0[id[k]], x1[id[k]]);
-    return vertexTriangle ? passedThrough(a0, a1) : edgesPassedThrough(a0, a1);
-  };
-  const auto pairIds = [&](size_t k) -> std::array<int, 4> {
-    if (k < s.pairs.size()) {
-      const auto& tri = mesh.triangles[s.pairs[k][1]];
-      return {s.pairs[k][0], tri[0], tri[1], tri[2]};
-    }
-    const auto& [a, b] = s.edgePairs[k - s.pairs.size()];
-    return {mesh.edges[a][0], mesh.edges[a][1], mesh.edges[b][0], mesh.edges[b][1]};
-  };
-  const size_t pairs = s.pairs.size() + s.edgePairs.size();
-  std::vector<int>& zone = s.zone;  // union-find over the points; -1: in no zone
-  zone.assign(s.moved.size(), -1);
-  std::vector<int> members;  // the points in zones, with their motion before the zones
-  std::vector<std::pair<Vec3, Vec3>>& before = s.zoneMotion;
-  const auto root = [&](int v) {
-    while (zone[v] != v) v = zone[v] = zone[zone[v]];
-    return v;
-  };
-  for (int round = 0; round < kZoneRounds; ++round) {
-    bool joined = false;
-    for (size_t k = 0; k < pairs; ++k) {
-      const std::array<int, 4> id = pairIds(k);
-      if (!through(id, k < s.pairs.size())) continue;
-      int r = -1;
-      for (int v : id) {
-        if (invMass[v] == 0.0f) continue;
-        if (zone[v] < 0) {
-          zone[v] = v;
-          members.push_back(v);
-          before.resize(static_cast<size_t>(v) + 1 > before.size() ? static_cast<size_t>(v) + 1 : before.size());
-          before[v] = {x1[v] - x0[v], vel[v]};
-        }
-        const int rv = root(v);
-        if (r >= 0 && rv != r) zone[std::max(rv, r)] = std::min(rv, r);
-        r = r < 0 ? rv : std::min(rv, r);
-        joined = true;
-      }
-    }
-    if (!joined) break;
-    // each zone's mean displacement and velocity, weighted by mass, from its points' own motion
-    std::vector<Vec3>& sum = s.zoneSum;
-    std::vector<Vec3>& sumV = s.zoneSumV;
-    std::vector<float>& mass = s.zoneMass;
-    sum.assign(s.moved.size(), Vec3::Zero());
-    sumV.assign(s.moved.size(), Vec3::Zero());
-    mass.assign(s.moved.size(), 0.0f);
-    for (int v : members) {
-      const int r = root(v);
-      const float m = 1.0f / invMass[v];
-      sum[r] += m * before[v].first;
-      sumV[r] += m * before[v].second;
-      mass[r] += m;
-    }
-    for (int v : members) {
-      const int r = root(v);
-      x1[v] = x0[v] + sum[r] / mass[r];
-      vel[v] = sumV[r] / mass[r];
-      s.moved[v] = 1;
-    }
-  }
-  return static_cast<int>(members.size());
 }
 
 }  // namespace
