@@ -305,24 +305,33 @@ void cellsOf(const Vec3& lo, const Vec3& hi, float cell, std::array<int, 3>& cLo
   }
 }
 
+// f(ci, cj, ck) for every cell of [cLo, cHi]
+template <typename F>
+void forCellRange(const std::array<int, 3>& cLo, const std::array<int, 3>& cHi, F&& f) {
+  for (int ci = cLo[0]; ci <= cHi[0]; ++ci)
+    for (int cj = cLo[1]; cj <= cHi[1]; ++cj)
+      for (int ck = cLo[2]; ck <= cHi[2]; ++ck) f(ci, cj, ck);
+}
+
+// whether cell c is the first (the lowest in each axis) that a query from cLo shares with a
+// primitive whose cells start at pLo: a pair met in several cells is counted there only
+bool firstSharedCell(const std::array<int, 3>& c, const std::array<int, 3>& cLo, const std::array<int, 3>& pLo) {
+  return c[0] == std::max(cLo[0], pLo[0]) && c[1] == std::max(cLo[1], pLo[1]) && c[2] == std::max(cLo[2], pLo[2]);
+}
+
 // calls f(triangle) once for every triangle whose padded box overlaps the box [lo, hi] (a vertex's
-// sweep): met in every cell both share, counted in the first (the lowest in each axis)
+// sweep): met in every cell both share, counted in the first
 template <typename F>
 void forTrianglesMeeting(const Vec3& lo, const Vec3& hi, const BoxGrid& g, F&& f) {
   std::array<int, 3> cLo, cHi;
   cellsOf(lo, hi, g.cell, cLo, cHi);
-  for (int ci = cLo[0]; ci <= cHi[0]; ++ci)
-    for (int cj = cLo[1]; cj <= cHi[1]; ++cj)
-      for (int ck = cLo[2]; ck <= cHi[2]; ++ck) {
-        const uint32_t b = bucketOf(ci, cj, ck);
-        for (uint32_t e = g.bucketStart[b]; e < g.bucketStart[b + 1]; ++e) {
-          const BoxGrid::Entry& en = g.entry[e];
-          if (outsideBox(lo, hi, en)) continue;
-          const auto& tl = g.cellLo[en.id];
-          if (ci != std::max(cLo[0], tl[0]) || cj != std::max(cLo[1], tl[1]) || ck != std::max(cLo[2], tl[2])) continue;
-          f(en.id);
-        }
-      }
+  forCellRange(cLo, cHi, [&](int ci, int cj, int ck) {
+    const uint32_t b = bucketOf(ci, cj, ck);
+    for (uint32_t e = g.bucketStart[b]; e < g.bucketStart[b + 1]; ++e) {
+      const BoxGrid::Entry& en = g.entry[e];
+      if (!outsideBox(lo, hi, en) && firstSharedCell({ci, cj, ck}, cLo, g.cellLo[en.id])) f(en.id);
+    }
+  });
 }
 
 // calls f(j) once for every edge j after edge i whose padded box overlaps i's own (unpadded) box: j
@@ -333,22 +342,16 @@ void forEdgesMeeting(size_t i, const BoxGrid& g, F&& f) {
   const Vec3 lo = g.boxLo[i] + Vec3::Constant(g.pad), hi = g.boxHi[i] - Vec3::Constant(g.pad);
   std::array<int, 3> cLo, cHi;
   cellsOf(lo, hi, g.cell, cLo, cHi);
-  for (int ci = cLo[0]; ci <= cHi[0]; ++ci)
-    for (int cj = cLo[1]; cj <= cHi[1]; ++cj)
-      for (int ck = cLo[2]; ck <= cHi[2]; ++ck) {
-        const uint32_t b = bucketOf(ci, cj, ck);
-        const auto begin = g.entry.begin() + g.bucketStart[b], end = g.entry.begin() + g.bucketStart[b + 1];
-        const auto after =
-            std::upper_bound(begin, end, int(i), [](int v, const BoxGrid::Entry& en) { return v < en.id; });
-        for (auto e = after; e != end; ++e) {
-          const int j = e->id;
-          if (e != after && (e - 1)->id == j) continue;
-          if (outsideBox(lo, hi, *e)) continue;
-          const auto& jl = g.cellLo[j];
-          if (ci != std::max(cLo[0], jl[0]) || cj != std::max(cLo[1], jl[1]) || ck != std::max(cLo[2], jl[2])) continue;
-          f(j);
-        }
-      }
+  forCellRange(cLo, cHi, [&](int ci, int cj, int ck) {
+    const uint32_t b = bucketOf(ci, cj, ck);
+    const auto begin = g.entry.begin() + g.bucketStart[b], end = g.entry.begin() + g.bucketStart[b + 1];
+    const auto after = std::upper_bound(begin, end, int(i), [](int v, const BoxGrid::Entry& en) { return v < en.id; });
+    for (auto e = after; e != end; ++e) {
+      const int j = e->id;
+      if (e != after && (e - 1)->id == j) continue;
+      if (!outsideBox(lo, hi, *e) && firstSharedCell({ci, cj, ck}, cLo, g.cellLo[j])) f(j);
+    }
+  });
 }
 
 constexpr int64_t kChunk = 256;  // vertices or edges a chunk of the parallel pair search

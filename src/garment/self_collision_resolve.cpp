@@ -107,31 +107,34 @@ int impactZones(const SelfCollisionMesh& mesh, const std::vector<float>& invMass
   zone.assign(s.moved.size(), -1);
   std::vector<int> members;  // the points in zones, with their motion before the zones
   std::vector<std::pair<Vec3, Vec3>>& before = s.zoneMotion;
+  before.resize(s.moved.size());
   const auto root = [&](int v) {
     while (zone[v] != v) v = zone[v] = zone[zone[v]];
     return v;
   };
   for (int round = 0; round < kZoneRounds; ++round) {
-    bool joined = false;
+    bool joined = false;  // a point joined a zone, or two zones merged
     for (size_t k = 0; k < pairs; ++k) {
       const std::array<int, 4> id = pairIds(k);
       if (!through(id, k < s.pairs.size())) continue;
       int r = -1;
       for (int v : id) {
-        if (invMass[v] == 0.0f) continue;
+        if (invMass[v] == 0.0f) continue;  // pinned or disturbed: keeps its own motion
         if (zone[v] < 0) {
           zone[v] = v;
           members.push_back(v);
-          before.resize(static_cast<size_t>(v) + 1 > before.size() ? static_cast<size_t>(v) + 1 : before.size());
           before[v] = {x1[v] - x0[v], vel[v]};
+          joined = true;
         }
         const int rv = root(v);
-        if (r >= 0 && rv != r) zone[std::max(rv, r)] = std::min(rv, r);
+        if (r >= 0 && rv != r) {
+          zone[std::max(rv, r)] = std::min(rv, r);
+          joined = true;
+        }
         r = r < 0 ? rv : std::min(rv, r);
-        joined = true;
       }
     }
-    if (!joined) break;
+    if (!joined) break;  // every pair still through is within one zone already (a held point in it)
     // each zone's mean displacement and velocity, weighted by mass, from its points' own motion
     std::vector<Vec3>& sum = s.zoneSum;
     std::vector<Vec3>& sumV = s.zoneSumV;

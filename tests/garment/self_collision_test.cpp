@@ -329,18 +329,25 @@ TEST(GarmentSelfCollision, EdgesPastEachOthersEndsParallelOrInOneSheetAreLeftAlo
   EXPECT_NEAR(bOverA(under, 0.9f), -0.008f, 1e-6f);
 }
 
-// two 2 cm wide strips of one piece at right angles, 1 cm apart; the upper (along y) tilts, one end
-// 2 cm down, through the lower (along x): no vertex of either lies over the other's triangles, only
-// their edges cross
-TEST(GarmentSelfCollision, StripsCrossingOnlyAtTheirEdgesAreKeptApart) {
-  Particles start;
+// two 2 cm wide strips of one piece at right angles, 1 cm apart: the lower (vertices 0-3) along x in
+// z = 0, the upper (4-7) along y moving down at `speed`, its end at y = -0.5 lowered by `drop` in the step
+Particles crossedStrips(float speed, float drop) {
+  Particles p;
   for (float y : {-0.01f, 0.01f})
-    for (float x : {-0.5f, 0.5f}) start.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0), Vec3::Zero());
+    for (float x : {-0.5f, 0.5f}) p.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0), Vec3::Zero());
   for (float y : {-0.5f, 0.5f})
-    for (float x : {-0.01f, 0.01f}) start.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0.01f), Vec3(0, 0, -1));
-  start.xPred = start.x;
-  for (int i = 4; i < 6; ++i) start.xPred[i].z() -= 0.02f;  // the end at y = -0.5
-  const std::vector<std::array<int, 3>> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
+    for (float x : {-0.01f, 0.01f}) p.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0.01f), Vec3(0, 0, -speed));
+  p.xPred = p.x;
+  for (int i = 4; i < 6; ++i) p.xPred[i].z() -= drop;
+  return p;
+}
+const std::vector<std::array<int, 3>> kStripTriangles = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
+
+// the upper strip tilts, one end 2 cm down, through the lower: no vertex of either lies over the
+// other's triangles, only their edges cross
+TEST(GarmentSelfCollision, StripsCrossingOnlyAtTheirEdgesAreKeptApart) {
+  const Particles start = crossedStrips(1.0f, 0.02f);
+  const std::vector<std::array<int, 3>>& tris = kStripTriangles;
   const SelfCollisionMesh mesh = buildSelfCollisionMesh(8, tris, {});
   const std::vector<float> inv(8, 1.0f);
   const auto crossings = [&](const Particles& p) { return testing::countCrossingTriangles(p.xPred, tris); };
@@ -364,23 +371,16 @@ TEST(GarmentSelfCollision, StripsCrossingOnlyAtTheirEdgesAreKeptApart) {
 // 20 cm through the lower strip, far past the pads, and only their edges meet. The edge-edge sweep
 // finds them and the fail-safe keeps the upper strip's middle over the lower (where it started)
 TEST(GarmentSelfCollision, StripsPassingFarThroughEachOtherInOneStepKeepTheirSides) {
-  Particles p;
-  for (float y : {-0.01f, 0.01f})
-    for (float x : {-0.5f, 0.5f}) p.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0), Vec3::Zero());
-  for (float y : {-0.5f, 0.5f})
-    for (float x : {-0.01f, 0.01f}) p.add(1, 0, 1.0f, 0.01f, Vec3(x, y, 0.01f), Vec3(0, 0, -12));
-  p.xPred = p.x;
-  for (int i = 4; i < 6; ++i) p.xPred[i].z() -= 0.4f;
+  Particles p = crossedStrips(12.0f, 0.4f);
   const auto middleHeight = [&](int a, int b) { return 0.5f * (p.xPred[a].z() + p.xPred[b].z()); };
   ASSERT_LT(middleHeight(4, 7), middleHeight(0, 3) - 0.1f);  // the upper strip's middle ends 20 cm under
-  const std::vector<std::array<int, 3>> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 7}, {4, 7, 6}};
   SelfCollisionScratch s;
   const SelfCollisionPushes pushes =
-      selfCollide(buildSelfCollisionMesh(8, tris, {}), 0, 8, std::vector<float>(8, 1.0f), 0.008f, p, s);
+      selfCollide(buildSelfCollisionMesh(8, kStripTriangles, {}), 0, 8, std::vector<float>(8, 1.0f), 0.008f, p, s);
   EXPECT_GT(s.edgePairs.size(), 0u);
   EXPECT_EQ(pushes.reverted, 8);  // every point joins the zone
   EXPECT_GT(middleHeight(4, 7), middleHeight(0, 3));
-  EXPECT_EQ(testing::countCrossingTriangles(p.xPred, tris), 0u);
+  EXPECT_EQ(testing::countCrossingTriangles(p.xPred, kStripTriangles), 0u);
 }
 
 }  // namespace
