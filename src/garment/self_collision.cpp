@@ -254,7 +254,8 @@ void BoxGrid::forCells(size_t t, F&& f) const {
       for (int k = cellLo[t][2]; k <= cellHi[t][2]; ++k) f(bucketOf(i, j, k));
 }
 
-// hashes every primitive into the cells its end-of-step box, padded by `pad`, overlaps (counting sort)
+// hashes every primitive into the cells its box over its sweep (its points at x0 and x1), padded by
+// `pad`, overlaps (counting sort)
 template <size_t K>
 void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3* x0, const Vec3* x1, float cellSize,
                     float padding) {
@@ -288,7 +289,6 @@ void BoxGrid::build(const std::span<const std::array<int, K>> prims, const Vec3*
 }
 
 namespace {
-
 
 // whether the box [lo, hi] misses the entry's box: the six comparisons joined without branches (the
 // scans' hot test; the result is `(hi < en.lo).any() || (lo > en.hi).any()`)
@@ -377,9 +377,10 @@ bool projectsNear(const std::array<Vec3, 4>& x1, float near) {
 }
 
 // the step's proximity pairs (vertex, triangle), in vertex order: every free vertex with every
-// triangle whose padded box holds it and that does not hold its seam group, unless it is clear by
-// kNearThicknesses on its side or its projection is one thickness less far outside the triangle.
-// Chunks of vertices in parallel, joined in order: the same pairs for any thread count
+// triangle whose padded box meets its sweep and that does not hold its seam group, unless it is clear
+// by kNearThicknesses on its side or its projection is one thickness less far outside the triangle,
+// and it did not pass through the triangle during the step. Chunks of vertices in parallel, joined in
+// order: the same pairs for any thread count
 void findPairs(const std::vector<std::array<int, 3>>& tris, const std::vector<int>& group, int count,
                const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1, float thickness,
                SelfCollisionScratch& s) {
@@ -421,8 +422,9 @@ bool edgesApart(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, fl
 }
 
 // the step's edge-edge pairs (A, B), A < B, in A's order: edges with a free vertex, no seam group in
-// common and none sharing a triangle with the other's, B's padded box overlapping A's box, unless
-// apart (edgesApart, as findPairs). Chunks in parallel, joined in order
+// common and none sharing a triangle with the other's, B's padded box overlapping A's box (boxes over
+// their sweeps), unless apart (edgesApart, as findPairs) and not passed through each other during the
+// step. Chunks in parallel, joined in order
 void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invMass, const Vec3* x0, const Vec3* x1,
                    float thickness, SelfCollisionScratch& s) {
   const auto& edges = mesh.edges;
@@ -443,9 +445,9 @@ void findEdgePairs(const SelfCollisionMesh& mesh, const std::vector<float>& invM
                    if (gc == ga || gc == gb || gd == ga || gd == gb) return;
                    const std::array<Vec3, 4> a0{x0[ea[0]], x0[ea[1]], x0[eb[0]], x0[eb[1]]};
                    const std::array<Vec3, 4> a1{x1[ea[0]], x1[ea[1]], x1[eb[0]], x1[eb[1]]};
-                   if ((edgesApart(a0, a1, near, outside) && !edgesPassedThrough(a0, a1)) || mesh.neighbours(ga, gc) ||
-                       mesh.neighbours(ga, gd) ||
-                       mesh.neighbours(gb, gc) || mesh.neighbours(gb, gd))
+                   const bool within = !edgesApart(a0, a1, near, outside) || edgesPassedThrough(a0, a1);
+                   if (!within || mesh.neighbours(ga, gc) || mesh.neighbours(ga, gd) || mesh.neighbours(gb, gc) ||
+                       mesh.neighbours(gb, gd))
                      return;
                    out.push_back({int(i), j});
                  });
