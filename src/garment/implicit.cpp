@@ -4,12 +4,12 @@
 
 #include <soak/error.hpp>
 
+#include "core/lap_clock.hpp"
 #include "core/parallel.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -475,13 +475,6 @@ SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g,
   return pushes;
 }
 
-// adds the wall ms since `t` to `ms` and restarts `t` there (ImplicitStats' parts)
-void lap(std::chrono::steady_clock::time_point& t, double& ms) {
-  const auto now = std::chrono::steady_clock::now();
-  ms += std::chrono::duration<double, std::milli>(now - t).count();
-  t = now;
-}
-
 // the share of its starting gap a seam's rest length still has at `time`
 float seamOpenFraction(const SeamParams& seams, double time) {
   return seams.closeTime > 0.0f ? static_cast<float>(std::max(0.0, 1.0 - time / seams.closeTime)) : 0.0f;
@@ -494,7 +487,7 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
                            const std::vector<PositionConstraint>& constraints, Particles& p, ImplicitScratch& w,
                            std::span<Vec3> velocityChange) {
   ImplicitStats stats;
-  auto clock = std::chrono::steady_clock::now();
+  LapClock clock;  // the step's parts, ImplicitStats::ms*
   const double hd = h;
   const bool sewn = g.springs.kindStart[4] > g.springs.kindStart[3];
   const bool sewing = sewn && time < params.seams.closeTime;
@@ -511,22 +504,22 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   for (int v = 0; !frictionless && v < g.count; ++v)
     w.fabricMu[v] = wetFriction(static_cast<size_t>(v) < saturation.size() ? saturation[v] : 0.0f, params.friction);
   contactRows(model, g, poses, p, h, w.fabricMu, w);
-  lap(clock, stats.msAssemble);
+  stats.msAssemble += clock.lap();
   const std::span<const Vec3> v0(p.v.data() + g.firstParticle, static_cast<size_t>(g.count));
   solveWithContact(params, v0, w, stats);
-  lap(clock, stats.msCg);
+  stats.msCg += clock.lap();
   if (velocityChange.size() == static_cast<size_t>(g.count))
     for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
   integrateWithContact(model, g, h, poses, p, w);
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
-  lap(clock, stats.msIntegrate);
+  stats.msIntegrate += clock.lap();
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision) {
     const SelfCollisionPushes pushes = selfCollisionStep(model, g, poses, p, w);
     stats.selfContacts = pushes.vertexTriangle;
     stats.selfEdgeContacts = pushes.edgeEdge;
     stats.selfReverted = pushes.reverted;
   }
-  lap(clock, stats.msSelfContact);
+  stats.msSelfContact += clock.lap();
   for (uint8_t c : w.constrained) stats.contacts += c == 3 ? 1 : 0;
   return stats;
 }
@@ -535,12 +528,11 @@ ImplicitStats garmentSubstep(const Model& model, const GarmentPiece& g, const Ga
                              std::span<const float> saturation, float h, double time, uint64_t stepIndex,
                              const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& scratch,
                              std::span<Vec3> velocityChange) {
-  auto clock = std::chrono::steady_clock::now();
+  LapClock clock;
   if (params.saturationMass) applySaturationMass(model, g.piece, saturation, params.saturation, p);  // Eq. 15-19
   const std::vector<PositionConstraint> wrinkles = computeDisturbances(model, g.piece, g.springs, g.subdomains, p, poses,
                                                                        params.wrinkles, stepIndex, saturation);  // 3.5
-  double msBefore = 0.0;
-  lap(clock, msBefore);
+  const double msBefore = clock.lap();  // part of the assembly
   ImplicitStats s =
       implicitStep(model, g, params, h, time, poses, saturation, wrinkles, p, scratch, velocityChange);  // Eq. 1-5
   s.msAssemble += msBefore;

@@ -185,12 +185,19 @@ bool closestOnLines(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
 // the end (opposite signs), passed through each other: at the fraction dist0 / (dist0 - dist1) of the
 // step, the points moving linearly, the lines' closest points lie within both edges (kCrossingSlack
 // of an edge's length beyond its ends). Edges that slid past each other's ends keep their new side
-bool edgesCrossed(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float dist0, float dist1) {
+// the closest points s, t of the edges' lines at the fraction dist0 / (dist0 - dist1) of the step (the
+// points moving linearly), when the edges are not within about 6 degrees of parallel then
+bool closestAtCrossing(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float dist0, float dist1,
+                       float& s, float& t) {
   const float f = dist0 / (dist0 - dist1);
   std::array<Vec3, 4> xs;
   for (int k = 0; k < 4; ++k) xs[k] = x0[k] + f * (x1[k] - x0[k]);
+  return closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t);
+}
+
+bool edgesCrossed(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, float dist0, float dist1) {
   float s, t;
-  if (!closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t)) return true;  // parallel then: keep the start's side
+  if (!closestAtCrossing(x0, x1, dist0, dist1, s, t)) return true;  // parallel then: keep the start's side
   const auto within = [](float u) { return u >= -kCrossingSlack && u <= 1.0f + kCrossingSlack; };
   return within(s) && within(t);
 }
@@ -208,12 +215,9 @@ bool edgesPassedThrough(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>
   const float minRaw2 = 0.01f * std::min(e0a.squaredNorm() * e0b.squaredNorm(), e1a.squaredNorm() * e1b.squaredNorm());
   if (!stepNormals(n0raw, n1raw, std::max(minRaw2, 1e-24f), n0, n1)) return false;
   const float dist0 = (x0[2] - x0[0]).dot(n0), dist1 = (x1[2] - x1[0]).dot(n1);
-  if (!(dist0 * dist1 < 0.0f)) return false;
-  const float f = dist0 / (dist0 - dist1);
-  std::array<Vec3, 4> xs;
-  for (int k = 0; k < 4; ++k) xs[k] = x0[k] + f * (x1[k] - x0[k]);
   float s, t;
-  return closestOnLines(xs[0], xs[1], xs[2], xs[3], s, t) && s >= 0.0f && s <= 1.0f && t >= 0.0f && t <= 1.0f;
+  return dist0 * dist1 < 0.0f && closestAtCrossing(x0, x1, dist0, dist1, s, t) && s >= 0.0f && s <= 1.0f && t >= 0.0f &&
+         t <= 1.0f;
 }
 
 bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std::array<Vec3, 4>& v,

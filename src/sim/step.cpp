@@ -2,6 +2,7 @@
 #include <soak/step.hpp>
 
 #include "core/parallel.hpp"
+#include "core/lap_clock.hpp"
 #include "garment/stage.hpp"
 #include "pbd/integrate.hpp"
 #include "sim/diagnostics.hpp"
@@ -9,7 +10,6 @@
 #include "world/emitters.hpp"
 
 #include <algorithm>
-#include <chrono>
 
 namespace soak {
 
@@ -21,16 +21,12 @@ constexpr uint64_t kSortEverySteps = 10;  // the water moves less than a cell in
 // one of its parts)
 struct StageClock {
   StageTimes& ms;
-  std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
-  void lap(double& stage) {
-    const auto now = std::chrono::steady_clock::now();
-    stage += std::chrono::duration<double, std::milli>(now - t).count();
-    t = now;
-  }
+  LapClock clock;
+  void lap(double& stage) { stage += clock.lap(); }
   void lap(double& stage, StagePart part) {
-    const double before = stage;
-    lap(stage);
-    ms.part(part) += stage - before;
+    const double t = clock.lap();
+    stage += t;
+    ms.part(part) += t;
   }
 };
 
@@ -118,7 +114,7 @@ void wet(const Model& model, State& state, Workspace& ws, float wetDt, StageCloc
 // dt after its last substep, or the substep's h after each with wetting.everySubstep)
 void substep(const Model& model, State& state, Workspace& ws, float h, float wetDt,
              std::span<const std::vector<Keyframe>> colliderKeys, StepStats& stats) {
-  StageClock clock{stats.ms};
+  StageClock clock{stats.ms, LapClock{}};
   predict(model, state, ws, h, colliderKeys, stats, clock);                         // x* = x + dt v
   project(model, state, ws, h, stats, clock);                                       // neighbours, constraints
   updateVelocitiesAndCommit(model, ws, state.particles, h, stats, clock);           // v, then x = x*
@@ -139,7 +135,7 @@ WorkspacePtr makeWorkspace() { return WorkspacePtr(new Workspace()); }
 
 void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& stats,
           std::span<const std::vector<Keyframe>> colliderKeys) {
-  const auto start = std::chrono::steady_clock::now();
+  LapClock total;
   const int n = std::max(1, model.solver.substeps);
   const float h = dt / static_cast<float>(n);
   if (state.stepCount % kSortEverySteps == 0)                                       // water in cell order:
@@ -151,7 +147,7 @@ void step(const Model& model, State& state, Workspace& ws, float dt, StepStats& 
   stats.substeps += n;
   stats.maxSpeed = maxSpeed(state.particles);
   ++state.stepCount;
-  stats.ms.total += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.ms.total += total.lap();
 }
 
 Keyframe poseAt(std::span<const Keyframe> keys, double t) {
