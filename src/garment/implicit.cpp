@@ -257,17 +257,21 @@ Vec3d rowResidual(const BlockMatrix& A, const std::vector<Vec3d>& dv, const std:
   return sum;
 }
 
-// a vertex at x touching collider c (its surface moving at vCol) along its outward normal nrm: the
-// velocity into the collider is removed and Coulomb friction (the fabric's mixed with the
-// collider's) acts on the slip, with the removed normal velocity as its impulse; x gives back the
-// slip friction removed during the step
-void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm, float muFabric, float h, Vec3& x,
-                     Vec3& vel) {
+// a vertex at x, just pushed out by `pushed` along the outward normal nrm of collider c (its surface
+// moving at vCol): the velocity into the collider is removed and Coulomb friction (the fabric's mixed
+// with the collider's) acts on the slip, with the removed normal velocity as its impulse; x gives back
+// the slip friction removed while in contact. The vertex was in contact for the part of the step the
+// push undid, pushed / (inward speed), not the whole step: a vertex that arrived mid-step had slipped
+// for only that long (docs/garment.md departure 10; the whole step moved a landing patch's vertices
+// inward by h v_t and compressed its springs by h v / R, which bounced the Fig. 8 silk off the ball)
+void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm, float muFabric, float h, float pushed,
+                     Vec3& x, Vec3& vel) {
   Vec3 rel = vel - vCol;
   const float dvn = std::max(-rel.dot(nrm), 0.0f);
   rel += dvn * nrm;  // the inward velocity is removed
   const Vec3 after = coulombFriction(rel, nrm, mixFriction(muFabric, collider.friction), dvn);
-  x += h * (after - rel);  // friction acted during the step: the slip it removed is not travelled
+  const float inContact = dvn * h > pushed ? pushed / dvn : h;
+  x += inContact * (after - rel);  // friction acted while in contact: the slip it removed is not travelled
   vel = vCol + after;
 }
 
@@ -395,9 +399,11 @@ void integrateWithContact(const Model& model, const GarmentPiece& g, float h, co
     bool contact = held >= 0;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm, vCol;
+      const Vec3 inside = x;
       if (!pushOutOf(model.colliders[c], poses[c], margin, x, &nrm, &vCol)) continue;  // project out to the margin
       contact = true;
-      contactResponse(model.colliders[c], vCol, nrm, static_cast<int>(c) == held ? 0.0f : muFabric, h, x, vel);
+      contactResponse(model.colliders[c], vCol, nrm, static_cast<int>(c) == held ? 0.0f : muFabric, h,
+                      (x - inside).dot(nrm), x, vel);
     }
     p.xPred[i] = x;
     p.v[i] = vel;
@@ -442,7 +448,7 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
       for (const auto& [u, free] : {std::pair{a, ma}, std::pair{b, mb}}) {
         if (!free) continue;
         x[u] += push;
-        contactResponse(model.colliders[c], colliderVelocity(model.colliders[c], poses[c], x[u]), nrm, 0.0f, 0.0f, x[u],
+        contactResponse(model.colliders[c], colliderVelocity(model.colliders[c], poses[c], x[u]), nrm, 0.0f, 0.0f, 0.0f, x[u],
                         v[u]);  // frictionless: no slip removed
       }
       ++pushed;
@@ -469,7 +475,7 @@ SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g,
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm, vCol;
       if (!pushOutOf(model.colliders[c], poses[c], margin, p.xPred[first + v], &nrm, &vCol)) continue;
-      contactResponse(model.colliders[c], vCol, nrm, 0.0f, 0.0f, p.xPred[first + v], p.v[first + v]);
+      contactResponse(model.colliders[c], vCol, nrm, 0.0f, 0.0f, 0.0f, p.xPred[first + v], p.v[first + v]);
     }
   }
   return pushes;
