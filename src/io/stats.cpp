@@ -94,6 +94,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"selfEdgeContacts", g.selfEdgeContacts},
                     {"selfReverted", g.selfReverted},
                     {"disturbances", g.disturbances},
+                    {"maxStrain", g.maxStrain},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},
                     {"wetVertices", wet}};

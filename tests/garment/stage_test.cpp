@@ -428,6 +428,24 @@ TEST(GarmentRun, CgStoppedAtItsCapIsCountedNotHidden) {
   EXPECT_GT(total.garment.maxResidual, 1e-5);
 }
 
+// the frame statistics' maxStrain is the largest stretch-spring strain a solve started from (Eq. 11's
+// eps, which the KES law stiffens towards 1 / a2): the sheet hung by two corners, its last step
+TEST(GarmentRun, MaxStrainIsTheLargestStretchAStepStartedFrom) {
+  Scene s = fromString(kSheet, {"cloth.0.pin.corners=[0, 1]"});
+  run(s.model, s.state, 20);
+  const GarmentPiece& g = *s.model.pieces[0].implicit;
+  float expected = 0.0f;
+  for (int k = g.springs.kindStart[0]; k < g.springs.kindStart[1]; ++k) {
+    const Vec3 d = s.state.particles.x[g.firstParticle + g.springs.ids[k][1]] -
+                   s.state.particles.x[g.firstParticle + g.springs.ids[k][0]];
+    expected = std::max(expected, d.norm() / g.springs.restLength[k] - 1.0f);
+  }
+  StepStats total;
+  run(s.model, s.state, 1, &total);  // 2 substeps: the first starts from these positions
+  EXPECT_GT(expected, 1e-3f);        // the corners hold the sheet's weight
+  EXPECT_NEAR(total.garment.maxStrain, expected, 0.02f * expected);
+}
+
 // the saturation mass on a PBD piece: the same rain, PBD solver; with a3 scaled to 0.044 s the fabric
 // absorbs what reaches it at once, so the mass gained is the water held (capped at delta m_dry a vertex)
 TEST(GarmentRun, WetMassMakesAPbdClothHeavierToo) {

@@ -166,7 +166,9 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   s.garment.cgIterations = 30;
   s.garment.cgIterationsMax = 17;
   s.garment.dropsTaken = 4;
+  s.garment.maxStrain = 0.05f;
   fs.add(s);
+  s.garment.maxStrain = 0.02f;
   fs.add(s);
   const auto j = frameStatsJson(f.model, f.state, 3, fs);
   EXPECT_EQ(j["wetting"]["particlesAbsorbed"], 7);
@@ -175,6 +177,7 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   EXPECT_EQ(j["garment"]["solves"], 4);
   EXPECT_EQ(j["garment"]["cgIterations"], 60);
   EXPECT_EQ(j["garment"]["cgIterationsMax"], 17);
+  EXPECT_FLOAT_EQ(j["garment"]["maxStrain"].get<float>(), 0.05f);  // the largest, not a sum
   EXPECT_EQ(j["garment"]["dropsTaken"], 8);
   EXPECT_EQ(j["garment"]["dropsTakenTotal"], 11);
   EXPECT_EQ(j["garment"]["wetVertices"], 2);
