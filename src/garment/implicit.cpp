@@ -262,7 +262,7 @@ Vec3d rowResidual(const BlockMatrix& A, const std::vector<Vec3d>& dv, const std:
 // with the collider's) acts on the slip, with the removed normal velocity as its impulse; x gives back
 // the slip friction removed while in contact. The vertex was in contact for the part of the step the
 // push undid, pushed / (inward speed), not the whole step: a vertex that arrived mid-step had slipped
-// for only that long (docs/garment.md departure 10; the whole step moved a landing patch's vertices
+// for only that long (docs/garment.md departure 9; the whole step moved a landing patch's vertices
 // inward by h v_t and compressed its springs by h v / R, which bounced the Fig. 8 silk off the ball)
 void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm, float muFabric, float h, float pushed,
                      Vec3& x, Vec3& vel) {
