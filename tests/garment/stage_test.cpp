@@ -490,10 +490,10 @@ TEST(GarmentRun, WetSilkOnTheBallHangsLowerThanDry) {
   const double yDry = garmentShape(dry.model, dry.state).meanHeight, yWet = garmentShape(wet.model, wet.state).meanHeight;
   EXPECT_LT(yWet, yDry - 0.002) << "dry " << yDry << " wet " << yWet;
   // the contact rounds settle which rows stick before the last solve, so the exact solve drapes the
-  // wet silk the same (docs/garment.md, "The Fig. 8 silk drapes the same for any solve"): the loose
-  // solves at tolerances 1e-6 to 2e-5 end 0.27 to 0.62 mm below it, native and portable builds alike
-  // (where a fold settles moves with the rounding of the sums), against the 3.1-3.7 mm the water
-  // lowers it; three rounds at the full tolerance ended 0.9 mm off
+  // wet silk the same (docs/garment.md, "The Fig. 8 silk drapes the same for the loose and the exact
+  // solve"): the loose solves at tolerances 1e-6 to 2e-5 end 0.27 to 0.62 mm below it, native and
+  // portable builds alike (where a fold settles moves with the rounding of the sums), against the
+  // 3.1-3.7 mm the water lowers it; three rounds at the full tolerance ended 0.9 mm off
   std::vector<std::string> exactSet = wetSet;
   exactSet.insert(exactSet.end(), {"cloth.0.garment.cg.preconditioner=cholesky", "cloth.0.garment.cg.tolerance=1e-8"});
   Scene exact = loadScene(dir + "chen_fig8_silk_sphere_wet.json", exactSet);
