@@ -448,8 +448,8 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
       for (const auto& [u, free] : {std::pair{a, ma}, std::pair{b, mb}}) {
         if (!free) continue;
         x[u] += push;
-        contactResponse(model.colliders[c], colliderVelocity(model.colliders[c], poses[c], x[u]), nrm, 0.0f, 0.0f, 0.0f, x[u],
-                        v[u]);  // frictionless: no slip removed
+        contactResponse(model.colliders[c], colliderVelocity(model.colliders[c], poses[c], x[u]), nrm, 0.0f, 0.0f, 0.0f,
+                        x[u], v[u]);  // frictionless: no slip removed
       }
       ++pushed;
     }
