@@ -49,7 +49,7 @@ struct GarmentStats {
   uint64_t edgeContacts = 0;    // edge-collider contacts (an edge's midpoint pushed out)
   uint64_t selfContacts = 0;    // vertex-triangle pushes of an implicit piece's self-collision
   uint64_t selfEdgeContacts = 0;  // and its edge-edge pushes
-  uint64_t selfReverted = 0;    // vertices its fail-safe put back to their start (docs/garment.md, "Self-collision")
+  uint64_t selfReverted = 0;    // vertices its fail-safe moved into impact zones (docs/garment.md, "Self-collision")
   uint64_t disturbances = 0;    // wrinkle constraints applied (section 3.5)
   uint64_t dropsTaken = 0;      // water particles that wetted a piece and vanished into it
   float maxStrain = 0.0f;       // largest stretch-spring strain at the start of a solve (Eq. 11's eps)

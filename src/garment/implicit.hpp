@@ -91,7 +91,7 @@ struct ImplicitStats {
   int edgeContacts = 0;         // mesh edges whose midpoint was pushed out of a collider
   int selfContacts = 0;         // vertex-triangle pushes of the self-collision (material.selfCollision)
   int selfEdgeContacts = 0;     // its edge-edge pushes
-  int selfReverted = 0;         // vertices its fail-safe put back to their start (a pair still through)
+  int selfReverted = 0;         // vertices its fail-safe moved into impact zones (a pair still through)
   int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)
   float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
   // wall ms of the step's parts: forces, rows and system (with Eq. 15-19 and section 3.5), the CG with

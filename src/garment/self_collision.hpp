@@ -10,7 +10,8 @@
 // through each other during the step however fast (each primitive's box covers its sweep), are found
 // once per step, by chunks in parallel joined in order; the passes are Gauss-Seidel over those pairs,
 // vertex-triangle then edge-edge, serial: the result does not depend on the thread count. A pair still
-// through each other after them has its free points put back to their start, at rest (the fail-safe).
+// through each other after them joins a rigid impact zone, moved in translation by its mean motion
+// (the fail-safe, impactZones in self_collision_resolve.hpp).
 #pragma once
 #include <soak/math.hpp>
 #include <soak/model.hpp>
@@ -96,7 +97,7 @@ bool pushEdgeOffEdge(const std::array<Vec3, 4>& x0, std::array<Vec3, 4>& x1, std
 // s.moved. Returns the pushes made of each kind and the points the fail-safe put back.
 struct SelfCollisionPushes {
   int vertexTriangle = 0, edgeEdge = 0;
-  int reverted = 0;  // points put back to their start by the fail-safe (a pair still through each other)
+  int reverted = 0;  // points the fail-safe moved into impact zones (a pair still through each other)
 };
 SelfCollisionPushes selfCollide(const SelfCollisionMesh& mesh, int first, int count, const std::vector<float>& invMass,
                                 float thickness, Particles& p, SelfCollisionScratch& s);
