@@ -95,6 +95,7 @@ struct GarmentParams {
   CgPreconditioner cgPreconditioner = CgPreconditioner::BlockJacobi;
   bool cgWarmStart = false;           // the CG starts from the last substep's velocity change (State::clothVelocityChange)
   bool edgeContact = false;           // also push the mesh edges' midpoints out of the colliders (implicit.cpp)
+  bool strainLimiting = true;         // no stretch or shear spring ends a step past 1/a2 (strain_limit.hpp)
 };
 
 }  // namespace soak

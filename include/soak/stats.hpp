@@ -53,10 +53,11 @@ struct GarmentStats {
   uint64_t disturbances = 0;    // wrinkle constraints applied (section 3.5)
   uint64_t dropsTaken = 0;      // water particles that wetted a piece and vanished into it
   float maxStrain = 0.0f;       // largest stretch-spring strain at the start of a solve (Eq. 11's eps)
+  uint64_t strainLimited = 0;   // springs the strain limiting shortened to Eq. 11's pole (docs/garment.md, departure 2)
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; selfReverted += o.selfReverted; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; selfReverted += o.selfReverted; strainLimited += o.strainLimited; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     maxStrain = maxStrain > o.maxStrain ? maxStrain : o.maxStrain;
     return *this;
   }

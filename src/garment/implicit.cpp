@@ -1,6 +1,7 @@
 // backward Euler step of Chen et al. 2012 Eq. 1-5 (Baraff & Witkin 1998) with KES springs,
 // Rayleigh damping (Eq. 22-24), filtered constraints and wet-friction contact
 #include "garment/implicit.hpp"
+#include "garment/strain_limit.hpp"
 
 #include <soak/error.hpp>
 
@@ -457,27 +458,50 @@ int pushEdgesOut(const Model& model, const GarmentPiece& g, const std::vector<Co
   return pushed;
 }
 
-// self-collision of the piece (self_collision.hpp), then the vertices it moved are put back out of
-// the colliders (position only, no friction: their contact this step already had it)
-SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses,
-                                      Particles& p, ImplicitScratch& w) {
+// 1/m of each vertex of the piece into w.invMass, 0 for pinned and disturbed vertices (they keep their
+// place): the weights of the strain limiting and the self-collision
+void fillInverseMasses(const GarmentPiece& g, const Particles& p, ImplicitScratch& w) {
   const size_t first = static_cast<size_t>(g.firstParticle);
   w.invMass.resize(static_cast<size_t>(g.count));
   for (int v = 0; v < g.count; ++v)
     w.invMass[v] = (w.constrained[v] == 1 || w.constrained[v] == 2) ? 0.0f : 1.0f / p.mass[first + v];
-  const float thickness = model.pieces[static_cast<size_t>(g.piece)].material.thickness;
-  const SelfCollisionPushes pushes = selfCollide(g.mesh, g.firstParticle, g.count, w.invMass, thickness, p, w.self);
-  if (pushes.vertexTriangle + pushes.edgeEdge + pushes.reverted == 0) return pushes;
+}
+
+// the vertices marked in `moved` (and free) are put back out of the colliders, position only, no
+// friction: their contact this step already had it
+void pushMovedOut(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses,
+                  const std::vector<uint8_t>& moved, Particles& p, const ImplicitScratch& w) {
+  const size_t first = static_cast<size_t>(g.firstParticle);
   const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
   const size_t numColliders = std::min(model.colliders.size(), poses.size());
   for (int v = 0; v < g.count; ++v) {
-    if (!w.self.moved[v] || w.invMass[v] == 0.0f) continue;
+    if (!moved[v] || w.invMass[v] == 0.0f) continue;
     for (size_t c = 0; c < numColliders; ++c) {
       Vec3 nrm, vCol;
       if (!pushOutOf(model.colliders[c], poses[c], margin, p.xPred[first + v], &nrm, &vCol)) continue;
       contactResponse(model.colliders[c], vCol, nrm, 0.0f, 0.0f, 0.0f, p.xPred[first + v], p.v[first + v]);
     }
   }
+}
+
+// strain limiting (strain_limit.hpp), then the vertices it moved are put back out of the colliders;
+// returns the springs shortened
+int strainLimitStep(const Model& model, const GarmentPiece& g, const GarmentParams& params, float h,
+                    const std::vector<ColliderPose>& poses, Particles& p, ImplicitScratch& w) {
+  const size_t first = static_cast<size_t>(g.firstParticle), n = static_cast<size_t>(g.count);
+  const int shortened = limitStrain(g.springs, params.laws, w.invMass, h, std::span(p.xPred).subspan(first, n),
+                                    std::span(p.v).subspan(first, n), w.strainMoved);
+  if (shortened > 0) pushMovedOut(model, g, poses, w.strainMoved, p, w);
+  return shortened;
+}
+
+// self-collision of the piece (self_collision.hpp), then the vertices it moved are put back out of
+// the colliders
+SelfCollisionPushes selfCollisionStep(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses,
+                                      Particles& p, ImplicitScratch& w) {
+  const float thickness = model.pieces[static_cast<size_t>(g.piece)].material.thickness;
+  const SelfCollisionPushes pushes = selfCollide(g.mesh, g.firstParticle, g.count, w.invMass, thickness, p, w.self);
+  if (pushes.vertexTriangle + pushes.edgeEdge + pushes.reverted > 0) pushMovedOut(model, g, poses, w.self.moved, p, w);
   return pushes;
 }
 
@@ -517,6 +541,8 @@ ImplicitStats implicitStep(const Model& model, const GarmentPiece& g, const Garm
   if (velocityChange.size() == static_cast<size_t>(g.count))
     for (int v = 0; v < g.count; ++v) velocityChange[v] = w.dv[v].cast<float>();
   integrateWithContact(model, g, h, poses, p, w);
+  fillInverseMasses(g, p, w);
+  if (params.strainLimiting) stats.strainLimited = strainLimitStep(model, g, params, h, poses, p, w);  // departure 2
   if (params.edgeContact) stats.edgeContacts = pushEdgesOut(model, g, poses, p, w);
   stats.msIntegrate += clock.lap();
   if (model.pieces[static_cast<size_t>(g.piece)].material.selfCollision) {

@@ -6,7 +6,7 @@
 // position constraints (wrinkles.hpp) and the contact of vertices resting on a collider, with Coulomb
 // friction at the wet friction curve of Fig. 5 (wet_friction.hpp), enforced by the filtered PCG of
 // block_cg.hpp; after the solve, contact and friction of the vertices that reached a collider during
-// the step.
+// the step, the strain limiting (strain_limit.hpp) and the self-collision (self_collision.hpp).
 //
 // Use from the step, for a piece whose scene says "solver": "implicit" (docs/garment.md): one call
 //   ImplicitStats s = garmentSubstep(model, g, params, saturation, h, time, stepIndex, poses, p, scratch);
@@ -74,7 +74,8 @@ struct ImplicitScratch {
   std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
-  std::vector<float> invMass;      // self-collision: 1/m, 0 for pinned and disturbed vertices
+  std::vector<float> invMass;      // strain limiting and self-collision: 1/m, 0 for pinned and disturbed vertices
+  std::vector<uint8_t> strainMoved;  // per vertex: moved by the strain limiting this step
   SelfCollisionScratch self;
 };
 
@@ -93,9 +94,11 @@ struct ImplicitStats {
   int selfEdgeContacts = 0;     // its edge-edge pushes
   int selfReverted = 0;         // vertices its fail-safe moved into impact zones (a pair still through)
   int disturbances = 0;         // wrinkle constraints applied (garmentSubstep)
+  int strainLimited = 0;        // stretch and shear springs the strain limiting shortened (strain_limit.hpp)
   float minStrain = 0.0f, maxStrain = 0.0f;  // over stretch springs, at the start of the step
   // wall ms of the step's parts: forces, rows and system (with Eq. 15-19 and section 3.5), the CG with
-  // its contact rounds, the integration with the collider and edge contact, the self-collision
+  // its contact rounds, the integration with the collider contact, strain limiting and edge contact,
+  // the self-collision
   double msAssemble = 0.0, msCg = 0.0, msIntegrate = 0.0, msSelfContact = 0.0;
 };
 

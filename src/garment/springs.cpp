@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace soak {
 
@@ -194,6 +195,12 @@ SpringSet buildPieceSprings(const Model& model, int piece, const SpringBuildOpti
   return buildSprings(rest, tris, options, pc.seams);
 }
 
+float kesPoleStrain(const KesLaw& law) { return law.a2 > 0.0f ? 1.0f / law.a2 : std::numeric_limits<float>::infinity(); }
+
+float kesContinuationStrain(const KesLaw& law, float strainLimit) {
+  return law.a2 > 0.0f ? strainLimit / law.a2 : std::numeric_limits<float>::infinity();
+}
+
 float kesStretchStress(float eps, const KesLaw& law, float strainLimit, float* dsigma) {
   const float a = std::abs(eps);
   const float sign = eps < 0.0f ? -1.0f : 1.0f;
@@ -204,14 +211,11 @@ float kesStretchStress(float eps, const KesLaw& law, float strainLimit, float* d
     *d = law.a1 * (1.0f + 2.0f * law.a2 * e) / (q3 * q);
     return law.a1 * e / q3;
   };
-  if (law.a2 > 0.0f) {
-    const float ec = strainLimit / law.a2;
-    if (a > ec) {
-      float dc;
-      const float sc = law11(ec, &dc);
-      if (dsigma) *dsigma = dc;
-      return sign * (sc + dc * (a - ec));
-    }
+  if (const float ec = kesContinuationStrain(law, strainLimit); a > ec) {
+    float dc;
+    const float sc = law11(ec, &dc);
+    if (dsigma) *dsigma = dc;
+    return sign * (sc + dc * (a - ec));
   }
   float d;
   const float s = law11(a, &d);
@@ -231,15 +235,12 @@ double kesStretchEnergy(double eps, const KesLaw& law, float strainLimit) {
     const double q = 1.0 - law.a2 * e;
     return law.a1 * e * e / (2.0 * q * q);
   };
-  if (law.a2 > 0.0f) {
-    const double ec = static_cast<double>(strainLimit) / law.a2;
-    if (a > ec) {
-      const double q = 1.0 - law.a2 * ec;
-      const double sc = law.a1 * ec / (q * q * q);
-      const double dc = law.a1 * (1.0 + 2.0 * law.a2 * ec) / (q * q * q * q);
-      const double r = a - ec;
-      return w(ec) + sc * r + 0.5 * dc * r * r;
-    }
+  if (const double ec = kesContinuationStrain(law, strainLimit); a > ec) {
+    const double q = 1.0 - law.a2 * ec;
+    const double sc = law.a1 * ec / (q * q * q);
+    const double dc = law.a1 * (1.0 + 2.0 * law.a2 * ec) / (q * q * q * q);
+    const double r = a - ec;
+    return w(ec) + sc * r + 0.5 * dc * r * r;
   }
   return w(a);
 }

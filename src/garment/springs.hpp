@@ -57,7 +57,11 @@ SpringSet buildSprings(const std::vector<Vec3>& rest, const std::vector<std::arr
 // the springs of cloth piece k of the model, from its rest shape (local indices)
 SpringSet buildPieceSprings(const Model& model, int piece, const SpringBuildOptions& options = {});
 
-// Eq. 11 with the tangent continuation past strainLimit / a2; dsigma = dsigma/deps (Eq. 13)
+// Eq. 11's pole, 1/a2, the strain its stress tends to infinity at (infinity for a2 = 0)
+float kesPoleStrain(const KesLaw& law);
+// the strain past which Eq. 11 is continued by its tangent, strainLimit / a2 (infinity for a2 = 0)
+float kesContinuationStrain(const KesLaw& law, float strainLimit);
+// Eq. 11 with the tangent continuation past kesContinuationStrain; dsigma = dsigma/deps (Eq. 13)
 float kesStretchStress(float eps, const KesLaw& law, float strainLimit, float* dsigma);
 // Eq. 14; dsigma = a1 + 2 a2 |eps|
 float kesBendStress(float eps, const KesLaw& law, float* dsigma);

@@ -255,6 +255,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
     gs.selfReverted += static_cast<uint64_t>(r.selfReverted);
     gs.disturbances += static_cast<uint64_t>(r.disturbances);
     gs.maxStrain = std::max(gs.maxStrain, r.maxStrain);
+    gs.strainLimited += static_cast<uint64_t>(r.strainLimited);
     stats.ms.part(StagePart::garmentAssemble) += r.msAssemble;
     stats.ms.part(StagePart::garmentCg) += r.msCg;
     stats.ms.part(StagePart::garmentIntegrate) += r.msIntegrate;

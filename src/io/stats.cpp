@@ -95,6 +95,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"selfReverted", g.selfReverted},
                     {"disturbances", g.disturbances},
                     {"maxStrain", g.maxStrain},
+                    {"strainLimited", g.strainLimited},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},
                     {"wetVertices", wet}};

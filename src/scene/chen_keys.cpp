@@ -101,6 +101,7 @@ void readGarmentSolver(ObjectReader r, GarmentParams& g) {
   g.rayleighBeta = ray.number("beta", d.rayleighBeta, Range::nonNegative());
   ray.finish();
   g.edgeContact = r.boolean("edgeContact", d.edgeContact);
+  g.strainLimiting = r.boolean("strainLimiting", d.strainLimiting);
   ObjectReader seams = r.object("seams");  // a sewn garment's (pattern meshes)
   g.seams.closeTime = seams.number("closeTime", d.seams.closeTime, Range::nonNegative());
   g.laws.seamStiffness = seams.number("stiffness", g.laws.stretch.a1, Range::positive());  // N/m; an edge's

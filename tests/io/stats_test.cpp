@@ -167,6 +167,7 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   s.garment.cgIterationsMax = 17;
   s.garment.dropsTaken = 4;
   s.garment.maxStrain = 0.05f;
+  s.garment.strainLimited = 3;
   fs.add(s);
   s.garment.maxStrain = 0.02f;
   fs.add(s);
@@ -178,6 +179,7 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   EXPECT_EQ(j["garment"]["cgIterations"], 60);
   EXPECT_EQ(j["garment"]["cgIterationsMax"], 17);
   EXPECT_FLOAT_EQ(j["garment"]["maxStrain"].get<float>(), 0.05f);  // the largest, not a sum
+  EXPECT_EQ(j["garment"]["strainLimited"], 6);
   EXPECT_EQ(j["garment"]["dropsTaken"], 8);
   EXPECT_EQ(j["garment"]["dropsTakenTotal"], 11);
   EXPECT_EQ(j["garment"]["wetVertices"], 2);

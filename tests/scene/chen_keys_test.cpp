@@ -268,7 +268,7 @@ TEST(ChenKeys, RainKeysReachTheEmitterAndEndMustFollowStart) {
 // damping, CG settings and the wrinkle model all reach ClothPiece::garment
 TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   const Scene s = fromString(kSheet, {R"(cloth.0.garment={"stretch": {"a1": 700, "a2": 2}, "shear": {"a1": 60, "a2": 0.5},
-      "bend": {"a1": 3, "a2": 1}, "strainLimit": 0.7, "bendStraightness": 0.6,
+      "bend": {"a1": 3, "a2": 1}, "strainLimit": 0.7, "strainLimiting": false, "bendStraightness": 0.6,
       "friction": {"dry": 0.2, "peak": 0.9, "plateau": 0.4, "peakSaturation": 0.15, "plateauSaturation": 0.8},
       "rayleigh": {"alpha": 0.5, "beta": 0.001}, "cg": {"tolerance": 1e-6, "maxIterations": 77, "preconditioner": "cholesky", "warmStart": true},
       "wrinkles": {"compressionThreshold": 0.1, "equilibriumSpeed": 0.3, "interval": 4, "patchSize": 50,
@@ -279,6 +279,7 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_FLOAT_EQ(g.laws.shear.a2, 0.5f);
   EXPECT_FLOAT_EQ(g.laws.bend.a1, 3.0f);
   EXPECT_FLOAT_EQ(g.laws.strainLimit, 0.7f);
+  EXPECT_FALSE(g.strainLimiting);
   EXPECT_FLOAT_EQ(g.build.bendStraightness, 0.6f);
   EXPECT_FLOAT_EQ(g.friction.dry, 0.2f);
   EXPECT_FLOAT_EQ(g.friction.peak, 0.9f);
@@ -309,9 +310,11 @@ TEST(ChenKeys, GarmentSolverKeysReachThePiece) {
   EXPECT_EQ(d.cgMaxIterations, defaults.cgMaxIterations);
   EXPECT_EQ(d.cgPreconditioner, CgPreconditioner::BlockJacobi);
   EXPECT_EQ(d.cgWarmStart, defaults.cgWarmStart);
+  EXPECT_TRUE(d.strainLimiting);
   EXPECT_EQ(fromString(kSheet, {"cloth.0.garment.cg.preconditioner=gaussSeidel"}).model.pieces[0].garment.cgPreconditioner,
             CgPreconditioner::GaussSeidel);
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.cg.warmStart=1"}), "at cloth[0].garment.cg.warmStart");
+  EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.strainLimiting=\"yes\""}), "at cloth[0].garment.strainLimiting");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.cg.preconditioner=ilu"}),
              "at cloth[0].garment.cg.preconditioner: expected one of \"blockJacobi\", \"cholesky\"");
   EXPECT_HAS(loadError(kSheet, {"cloth.0.garment.wrinkles.patchSize=2"}),
