@@ -1,6 +1,7 @@
 // backward Euler step of Chen et al. 2012 Eq. 1-5 (Baraff & Witkin 1998) with KES springs,
 // Rayleigh damping (Eq. 22-24), filtered constraints and wet-friction contact
 #include "garment/implicit.hpp"
+#include "garment/contact_rows.hpp"
 #include "garment/strain_limit.hpp"
 
 #include <soak/error.hpp>
@@ -180,84 +181,6 @@ void assembleSystem(const Model& model, const GarmentPiece& g, const GarmentPara
   });
 }
 
-// contact as a constraint of the solve (Baraff & Witkin 1998 section 5.3; Chen 2012 leaves contact to
-// after the solve: docs/garment.md departure 10): a free vertex within kContactBand margins of a
-// collider at the start of the step, which its own row's estimate v0 + A_ii^-1 b_i would take nearer
-// than the margin, gets a contact row: its velocity along the nearest collider's normal after the
-// step is prescribed, so that it comes down to the margin and never leaves the surface faster than
-// the surface moves. With friction it starts sticking (kStickRow: its tangential velocity the
-// surface's), without it slides (kContactRow); updateContactRows then applies Coulomb's law. A vertex
-// whose estimate leaves is not held: no glue. The solve's neighbours of a held vertex see it held,
-// where a push after the solve would stretch their springs. fabricFriction: the fabric's coefficient
-// per vertex, mixed with the collider's static and kinetic ones.
-constexpr float kContactBand = 1.25f;
-
-// the velocity after the step of a vertex sticking to a surface moving at vCol: the surface's along
-// the tangent plane, normalSpeed along the unit normal n
-Vec3d stickingVelocity(const Vec3d& n, double normalSpeed, const Vec3& vCol) {
-  const Vec3d vc = vCol.cast<double>();
-  return normalSpeed * n + (vc - vc.dot(n) * n);
-}
-
-void contactRows(const Model& model, const GarmentPiece& g, const std::vector<ColliderPose>& poses, const Particles& p,
-                 float h, std::span<const float> fabricFriction, ImplicitScratch& w) {
-  const size_t first = static_cast<size_t>(g.firstParticle);
-  const size_t numColliders = std::min(model.colliders.size(), poses.size());
-  const float margin = contactMargin(model, static_cast<int32_t>(g.piece + 1));
-  const float band = kContactBand * margin;
-  w.contactNormal.resize(static_cast<size_t>(g.count));
-  w.contactVelocity.resize(static_cast<size_t>(g.count));
-  w.contactMu.resize(static_cast<size_t>(g.count));
-  w.frictionImpulse.assign(static_cast<size_t>(g.count), Vec3d::Zero());
-  w.contactCollider.assign(static_cast<size_t>(g.count), -1);
-  parallelFor(numColliders ? g.count : 0, [&](int64_t v) {
-    if (w.constrained[v] != kFreeRow) return;
-    const Vec3& x0 = p.x[first + static_cast<size_t>(v)];
-    float nearest = band;
-    Vec3 nrm = Vec3::Zero(), vCol = Vec3::Zero();
-    for (size_t c = 0; c < numColliders; ++c) {
-      Vec3 y = x0, n, vc;
-      if (!pushOutOf(model.colliders[c], poses[c], band, y, &n, &vc)) continue;
-      const float d = band - (y - x0).dot(n);  // x0's distance to the surface
-      if (d >= nearest && w.contactCollider[v] >= 0) continue;
-      nearest = d;
-      nrm = n;
-      vCol = vc;
-      w.contactCollider[v] = static_cast<int>(c);
-    }
-    if (w.contactCollider[v] < 0) return;
-    // down to the margin, never faster out than the surface moves: a vertex found inside is put back by
-    // position after the solve (pushOutOf), so the row's impulse is the support alone and friction with it
-    const double vn = std::min((margin - nearest) / h, std::max(vCol.dot(nrm), 0.0f));
-    const Vec3d n = nrm.cast<double>();
-    const Vec3d v0 = p.v[first + static_cast<size_t>(v)].cast<double>();
-    const Vec3d estimate = v0 + w.A.block[g.rowStart[v]].ldlt().solve(w.rhs[v]);
-    if (estimate.dot(n) >= vn) {  // its own forces keep it off the margin
-      w.contactCollider[v] = -1;
-      return;
-    }
-    w.contactNormal[v] = n;
-    w.contactVelocity[v] = vCol;
-    const Collider& collider = model.colliders[static_cast<size_t>(w.contactCollider[v])];
-    const float fabric = fabricFriction[static_cast<size_t>(v)];
-    w.contactMu[v] = {mixFriction(fabric, collider.staticFriction), mixFriction(fabric, collider.friction)};
-    if (w.contactMu[v].staticCoef > 0.0f || w.contactMu[v].kinetic > 0.0f) {  // sticks first: moves with the surface
-      w.constrained[v] = kStickRow;
-      w.dv[v] = stickingVelocity(n, vn, vCol) - v0;
-    } else {  // frictionless: slides with the prescribed normal velocity, the tangential part guessed
-      w.constrained[v] = kContactRow;
-      w.dv[v] = (vn - v0.dot(n)) * n + (w.dv[v] - w.dv[v].dot(n) * n);
-    }
-  });
-}
-
-// (A dv - b) of row v: the impulse the row's constraint applies (zero on a free row)
-Vec3d rowResidual(const BlockMatrix& A, const std::vector<Vec3d>& dv, const std::vector<Vec3d>& b, int v) {
-  Vec3d sum = -b[v];
-  for (int k = A.rowStart[v]; k < A.rowStart[v + 1]; ++k) sum += A.block[k] * dv[A.col[k]];
-  return sum;
-}
-
 // a vertex at x, just pushed out by `pushed` along the outward normal nrm of collider c (its surface
 // moving at vCol): the velocity into the collider is removed and Coulomb friction (the fabric's mixed
 // with the collider's) acts on the slip, with the removed normal velocity as its impulse; x gives back
@@ -274,93 +197,6 @@ void contactResponse(const Collider& collider, const Vec3& vCol, const Vec3& nrm
   const float inContact = dvn * h > pushed ? pushed / dvn : h;
   x += inContact * (after - rel);  // friction acted while in contact: the slip it removed is not travelled
   vel = vCol + after;
-}
-
-// Coulomb friction inside the solve, as an active set over the contact rows (Baraff & Witkin 1998
-// section 5.3 release a row by the sign of its force; friction applied after the solve moved held
-// vertices back against neighbours the solve had let them drag: docs/garment.md departure 10). After
-// a solve each row's constraint impulse r = A dv - b (b holding a sliding row's friction) is split
-// into its support N = n . r and its tangential part T:
-//   N < 0 (the row pulls the vertex into the collider): released, a free vertex;
-//   sticking, |T| > mu_s N: it slides, with the kinetic impulse mu_k N T/|T| added to its b;
-//   sliding, its slip after the solve along its friction (friction reversed the slip): it sticks;
-//   sliding otherwise: its friction impulse follows the new support, mu_k N.
-// v0: the piece's velocities at the start of the step; impulseChange receives each row's change of
-// friction impulse. Returns whether a row changed kind.
-bool updateContactRows(std::span<const Vec3> v0, ImplicitScratch& w, std::vector<Vec3d>& impulseChange) {
-  bool changed = false;
-  for (int v = 0; v < w.A.rows; ++v) {
-    impulseChange[v].setZero();
-    if (!isContactRow(w.constrained[v])) continue;
-    const Vec3d n = w.contactNormal[v];
-    const Vec3d r = rowResidual(w.A, w.dv, w.rhs, v);  // a sliding row: its friction is in w.rhs, r is normal
-    const double support = n.dot(r);
-    Vec3d friction = Vec3d::Zero();
-    if (support < 0.0) {
-      w.constrained[v] = kFreeRow;
-      w.contactCollider[v] = -1;
-      changed = true;
-    } else if (w.constrained[v] == kStickRow) {
-      const Vec3d t = r - support * n;
-      const double limit = std::max(w.contactMu[v].staticCoef, w.contactMu[v].kinetic) * support;
-      if (t.norm() > limit) {
-        w.constrained[v] = kContactRow;
-        friction = (w.contactMu[v].kinetic * support / t.norm()) * t;
-        changed = true;
-      }
-    } else if (w.contactMu[v].kinetic > 0.0f) {
-      const Vec3d start = v0[static_cast<size_t>(v)].cast<double>(), v1 = start + w.dv[v];
-      const Vec3d along = w.frictionImpulse[v].normalized();
-      if (w.frictionImpulse[v].squaredNorm() > 0.0 && (v1 - w.contactVelocity[v].cast<double>()).dot(along) > 0.0) {
-        w.constrained[v] = kStickRow;
-        w.dv[v] = stickingVelocity(n, v1.dot(n), w.contactVelocity[v]) - start;
-        changed = true;
-      } else {
-        friction = w.contactMu[v].kinetic * support * along;
-      }
-    }
-    impulseChange[v] = friction - w.frictionImpulse[v];
-  }
-  return changed;
-}
-
-// the filtered PCG of Eq. 5 with the contact rows, solved again from the last solution while
-// updateContactRows changes a row's kind, at most kContactRounds more times. The rounds that only
-// decide the rows' kinds stop at kRoundLoosening times the tolerance (at most kRoundTolerance); the
-// last solve, on the settled kinds, at the tolerance itself (docs/garment.md departure 9).
-constexpr int kContactRounds = 8;
-constexpr double kRoundLoosening = 30.0;
-constexpr double kRoundTolerance = 3e-3;
-
-void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, ImplicitScratch& w, ImplicitStats& stats) {
-  CgOptions opt;
-  opt.maxIterations = params.cgMaxIterations;
-  opt.preconditioner = params.cgPreconditioner;
-  w.frictionChange.resize(static_cast<size_t>(w.A.rows));
-  const double tolerance = params.cgTolerance;
-  const double roundTolerance = std::max(tolerance, std::min(tolerance * kRoundLoosening, kRoundTolerance));
-  bool settled = std::none_of(w.constrained.begin(), w.constrained.end(), isContactRow);  // no row to change
-  for (int round = 0;; ++round) {
-    const bool last = settled || round == kContactRounds;
-    opt.tolerance = last ? tolerance : roundTolerance;
-    opt.sameMatrix = round > 0;  // the rounds change the filter and the right-hand side only
-    const CgResult cg = filteredPcg(w.A, w.rhs, w.constrained, w.dv, opt, w.cg, w.contactNormal);
-    stats.cgIterations += cg.iterations;
-    stats.cgResidual = cg.residual;
-    stats.converged = cg.converged;
-    stats.breakdown = stats.breakdown || cg.breakdown;
-    stats.factorFailed = stats.factorFailed || cg.factorFailed;
-    if (last) break;
-    settled = !updateContactRows(v0, w, w.frictionChange);
-    for (int v = 0; v < w.A.rows; ++v) {  // the new friction: a row that began to slide, or one whose support changed
-      w.rhs[v] += w.frictionChange[v];
-      w.frictionImpulse[v] += w.frictionChange[v];
-    }
-  }
-  for (int v = 0; v < w.A.rows; ++v) {
-    stats.contactRows += isContactRow(w.constrained[v]) ? 1 : 0;
-    stats.stickingRows += w.constrained[v] == kStickRow ? 1 : 0;
-  }
 }
 
 // v1 = v0 + dv, x1 = x0 + h v1 to p.xPred and p.v; then a vertex that ends within the margin of a

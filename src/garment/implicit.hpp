@@ -72,6 +72,9 @@ struct ImplicitScratch {
   std::vector<Vec3d> frictionImpulse;   // per vertex: a sliding row's kinetic friction on the right-hand side (kg m/s)
   std::vector<Vec3d> frictionChange;    // updateContactRows' change of frictionImpulse
   std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none
+  std::vector<double> contactSpeed;     // per vertex in a collider's band: the row's prescribed normal speed (m/s)
+  std::vector<int> watchedCollider;     // per vertex: in a collider's band but free (its forces hold it off), -1 none
+  std::vector<double> throughSpeed;     // per watched vertex: the normal speed below which it ends inside (m/s)
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
   std::vector<float> invMass;      // strain limiting and self-collision: 1/m, 0 for pinned and disturbed vertices
@@ -81,6 +84,7 @@ struct ImplicitScratch {
 
 struct ImplicitStats {
   int cgIterations = 0;
+  int solves = 0;            // CG solves: the contact rounds and the last (contact_rows.hpp)
   double cgResidual = 0.0;   // relative, at exit
   bool converged = true;     // false: the CG hit cgMaxIterations (or broke down); the step still ran
   bool breakdown = false;    // the system was not positive definite
