@@ -11,7 +11,7 @@ namespace soak {
 
 namespace {
 
-constexpr float kContactBand = 1.25f;
+constexpr float kContactBand = 1.25f;  // contactRows' reach, in contact margins (contact_rows.hpp)
 
 // the velocity after the step of a vertex sticking to a surface moving at vCol: the surface's along
 // the tangent plane, normalSpeed along the unit normal n
@@ -19,7 +19,6 @@ Vec3d stickingVelocity(const Vec3d& n, double normalSpeed, const Vec3& vCol) {
   const Vec3d vc = vCol.cast<double>();
   return normalSpeed * n + (vc - vc.dot(n) * n);
 }
-
 
 // vertex v (in w.contactNormal's band) becomes a contact row: sticking first, moving with the surface,
 // where it has friction; else sliding with the prescribed normal speed w.contactSpeed, the tangential
@@ -103,7 +102,8 @@ bool updateContactRows(std::span<const Vec3> v0, ImplicitScratch& w, std::vector
     } else if (w.contactMu[v].kinetic > 0.0f) {
       const Vec3d start = v0[static_cast<size_t>(v)].cast<double>(), v1 = start + w.dv[v];
       const Vec3d along = w.frictionImpulse[v].normalized();
-      if (w.frictionImpulse[v].squaredNorm() > 0.0 && (v1 - w.contactVelocity[v].cast<double>()).dot(along) > kSlipReversed) {
+      const double slip = (v1 - w.contactVelocity[v].cast<double>()).dot(along);  // along its friction: reversed
+      if (w.frictionImpulse[v].squaredNorm() > 0.0 && slip > kSlipReversed) {
         w.constrained[v] = kStickRow;
         w.dv[v] = stickingVelocity(n, v1.dot(n), w.contactVelocity[v]) - start;
         changed = true;
@@ -187,7 +187,8 @@ void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, Imp
   const double tolerance = params.cgTolerance;
   const double roundTolerance = std::max(tolerance, std::min(tolerance * kRoundLoosening, kRoundTolerance));
   const bool watching = std::any_of(w.watchedCollider.begin(), w.watchedCollider.end(), [](int c) { return c >= 0; });
-  bool settled = !watching && std::none_of(w.constrained.begin(), w.constrained.end(), isContactRow);  // no row to change
+  // no row to change and no vertex to watch: one solve
+  bool settled = !watching && std::none_of(w.constrained.begin(), w.constrained.end(), isContactRow);
   for (int round = 0;; ++round) {
     const bool last = settled || round == kContactRounds;
     opt.tolerance = last ? tolerance : roundTolerance;

@@ -39,7 +39,8 @@ int limitStrain(const SpringSet& springs, const SpringLaws& laws, std::span<cons
   moved.assign(x.size(), 0);
   int total = 0;
   for (int pass = 0; pass < kStrainLimitPasses; ++pass) {
-    const int n = limitPass(springs, springs.kindStart[0], springs.kindStart[1], laws.stretch, invMass, h, x, v, moved) +
+    const int n = limitPass(springs, springs.kindStart[0], springs.kindStart[1], laws.stretch, invMass, h, x, v,
+                            moved) +
                   limitPass(springs, springs.kindStart[1], springs.kindStart[2], laws.shear, invMass, h, x, v, moved);
     total += n;
     if (n == 0) break;
