@@ -73,7 +73,7 @@ struct ImplicitScratch {
   std::vector<Vec3d> frictionChange;    // updateContactRows' change of frictionImpulse
   std::vector<int> contactCollider;     // per vertex: the collider of its contact row, -1 none
   std::vector<double> contactSpeed;     // per vertex in a collider's band: the row's prescribed normal speed (m/s)
-  std::vector<int> watchedCollider;     // per vertex: in a collider's band but free (its forces hold it off), -1 none
+  std::vector<int> watchedCollider;     // per vertex: free in a collider's band (held off, or released), -1 none
   std::vector<double> throughSpeed;     // per watched vertex: the normal speed below which it ends inside (m/s)
   std::vector<Vec3> edgeMid;       // m, the mesh edges' midpoints (pushEdgesOut)
   std::vector<float> edgeBound;    // m, a lower bound of each midpoint's distance to the colliders
