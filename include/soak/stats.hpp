@@ -54,10 +54,11 @@ struct GarmentStats {
   uint64_t dropsTaken = 0;      // water particles that wetted a piece and vanished into it
   float maxStrain = 0.0f;       // largest stretch-spring strain at the start of a solve (Eq. 11's eps)
   uint64_t strainLimited = 0;   // springs the strain limiting shortened to Eq. 11's pole (docs/garment.md, departure 2)
+  uint64_t halvedSteps = 0;     // implicit steps redone as smaller steps: a vertex was faster than solver.maxSpeed
   GarmentStats& operator+=(const GarmentStats& o) {
     solves += o.solves; cgIterations += o.cgIterations; cgIterationsMax = cgIterationsMax > o.cgIterationsMax ? cgIterationsMax : o.cgIterationsMax;
     maxResidual = maxResidual > o.maxResidual ? maxResidual : o.maxResidual; unconverged += o.unconverged;
-    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; selfReverted += o.selfReverted; strainLimited += o.strainLimited; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
+    breakdowns += o.breakdowns; factorFailures += o.factorFailures; contacts += o.contacts; contactRows += o.contactRows; stickingRows += o.stickingRows; edgeContacts += o.edgeContacts; selfContacts += o.selfContacts; selfEdgeContacts += o.selfEdgeContacts; selfReverted += o.selfReverted; strainLimited += o.strainLimited; halvedSteps += o.halvedSteps; disturbances += o.disturbances; dropsTaken += o.dropsTaken;
     maxStrain = maxStrain > o.maxStrain ? maxStrain : o.maxStrain;
     return *this;
   }

@@ -2,6 +2,7 @@
 #include "garment/stage.hpp"
 
 #include "core/parallel.hpp"
+#include "pbd/integrate.hpp"
 #include "world/garment_mesh.hpp"
 #include "world/mesh_distance.hpp"
 
@@ -217,11 +218,86 @@ float touchDistance(const Model& model, const ClothPiece& piece) {
   return piece.material.thickness + model.water.spacing;
 }
 
+namespace {
+
+// a step's cost (CG iterations and wall time) into the frame's statistics: also a step that was redone
+void addStepCost(const ImplicitStats& r, StepStats& stats) {
+  stats.garment.cgIterations += static_cast<uint64_t>(r.cgIterations);
+  stats.garment.cgIterationsMax = std::max(stats.garment.cgIterationsMax, r.cgIterations);
+  stats.ms.part(StagePart::garmentAssemble) += r.msAssemble;
+  stats.ms.part(StagePart::garmentCg) += r.msCg;
+  stats.ms.part(StagePart::garmentIntegrate) += r.msIntegrate;
+  stats.ms.part(StagePart::garmentSelfContact) += r.msSelfContact;
+}
+
+// a step kept: its cost and what it did
+void addStepStats(const ImplicitStats& r, StepStats& stats) {
+  addStepCost(r, stats);
+  GarmentStats& gs = stats.garment;
+  ++gs.solves;
+  gs.maxResidual = std::max(gs.maxResidual, r.cgResidual);
+  gs.unconverged += r.converged ? 0 : 1;
+  gs.breakdowns += r.breakdown ? 1 : 0;
+  gs.factorFailures += r.factorFailed ? 1 : 0;
+  gs.contacts += static_cast<uint64_t>(r.contacts);
+  gs.contactRows += static_cast<uint64_t>(r.contactRows);
+  gs.stickingRows += static_cast<uint64_t>(r.stickingRows);
+  gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
+  gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
+  gs.selfEdgeContacts += static_cast<uint64_t>(r.selfEdgeContacts);
+  gs.selfReverted += static_cast<uint64_t>(r.selfReverted);
+  gs.disturbances += static_cast<uint64_t>(r.disturbances);
+  gs.maxStrain = std::max(gs.maxStrain, r.maxStrain);
+  gs.strainLimited += static_cast<uint64_t>(r.strainLimited);
+}
+
+float fastestOf(const Particles& p, size_t first, size_t count) {
+  float fastest = 0.0f;
+  for (size_t i = first; i < first + count; ++i) fastest = std::max(fastest, p.v[i].norm());
+  return fastest;
+}
+
+}  // namespace
+
+void stepPiece(const Model& model, State& state, GarmentScratch& s, size_t k, const PieceStepInputs& in, float h,
+               StepStats& stats) {
+  const ClothPiece& piece = model.pieces[k];
+  Particles& p = state.particles;
+  const size_t first = static_cast<size_t>(piece.firstParticle), n = static_cast<size_t>(piece.particleCount);
+  const auto run = [&](float hp, double time, const std::vector<ColliderPose>& poses) {
+    s.steps.push_back(garmentSubstep(model, *piece.implicit, piece.garment, in.saturation, hp, time, state.stepCount,
+                                     poses, p, s.scratch[k], in.velocityChange));
+  };
+  s.startX.assign(p.x.begin() + first, p.x.begin() + first + n);
+  s.startV.assign(p.v.begin() + first, p.v.begin() + first + n);
+  s.startDv.assign(in.velocityChange.begin(), in.velocityChange.end());
+  s.steps.clear();
+  run(h, state.time, in.poses);
+  // departure: a step that leaves a vertex faster than solver.maxSpeed, which would end the run as
+  // diverged, is redone from its start as 2, 4, then 8 steps (docs/garment.md departure 4)
+  for (int level = 1; level <= kMaxHalvings && fastestOf(p, first, n) > model.solver.maxSpeed; ++level) {
+    for (const ImplicitStats& r : s.steps) addStepCost(r, stats);  // the steps dropped
+    s.steps.clear();
+    ++stats.garment.halvedSteps;
+    const int parts = 1 << level;
+    const float hp = h / static_cast<float>(parts);
+    std::copy(s.startV.begin(), s.startV.end(), p.v.begin() + first);
+    std::copy(s.startDv.begin(), s.startDv.end(), in.velocityChange.begin());
+    for (int part = 0; part < parts; ++part) {
+      const double time = state.time + part * static_cast<double>(hp);
+      updateColliderPoses(model, time + hp, in.colliderKeys, s.partPoses);
+      if (part > 0) std::copy(p.xPred.begin() + first, p.xPred.begin() + first + n, p.x.begin() + first);
+      run(hp, time, s.partPoses);
+    }
+    std::copy(s.startX.begin(), s.startX.end(), p.x.begin() + first);  // the substep's start, for the commit
+  }
+  for (const ImplicitStats& r : s.steps) addStepStats(r, stats);
+}
+
 void solveGarments(const Model& model, State& state, GarmentScratch& s, const std::vector<ColliderPose>& poses,
-                   float h, StepStats& stats) {
+                   std::span<const std::vector<Keyframe>> colliderKeys, float h, StepStats& stats) {
   Particles& p = state.particles;
   s.scratch.resize(model.pieces.size());
-  GarmentStats& gs = stats.garment;
   for (size_t k = 0; k < model.pieces.size(); ++k) {
     const ClothPiece& piece = model.pieces[k];
     if (piece.wetByContact && !model.wetting.enabled && !state.clothSaturation.empty())
@@ -237,29 +313,7 @@ void solveGarments(const Model& model, State& state, GarmentScratch& s, const st
         state.clothVelocityChange.empty()
             ? std::span<Vec3>()
             : std::span<Vec3>(state.clothVelocityChange).subspan(size_t(piece.firstParticle), size_t(piece.particleCount));
-    const ImplicitStats r = garmentSubstep(model, *piece.implicit, piece.garment, saturation, h, state.time,
-                                           state.stepCount, poses, p, s.scratch[k], velocityChange);
-    ++gs.solves;
-    gs.cgIterations += static_cast<uint64_t>(r.cgIterations);
-    gs.cgIterationsMax = std::max(gs.cgIterationsMax, r.cgIterations);
-    gs.maxResidual = std::max(gs.maxResidual, r.cgResidual);
-    gs.unconverged += r.converged ? 0 : 1;
-    gs.breakdowns += r.breakdown ? 1 : 0;
-    gs.factorFailures += r.factorFailed ? 1 : 0;
-    gs.contacts += static_cast<uint64_t>(r.contacts);
-    gs.contactRows += static_cast<uint64_t>(r.contactRows);
-    gs.stickingRows += static_cast<uint64_t>(r.stickingRows);
-    gs.edgeContacts += static_cast<uint64_t>(r.edgeContacts);
-    gs.selfContacts += static_cast<uint64_t>(r.selfContacts);
-    gs.selfEdgeContacts += static_cast<uint64_t>(r.selfEdgeContacts);
-    gs.selfReverted += static_cast<uint64_t>(r.selfReverted);
-    gs.disturbances += static_cast<uint64_t>(r.disturbances);
-    gs.maxStrain = std::max(gs.maxStrain, r.maxStrain);
-    gs.strainLimited += static_cast<uint64_t>(r.strainLimited);
-    stats.ms.part(StagePart::garmentAssemble) += r.msAssemble;
-    stats.ms.part(StagePart::garmentCg) += r.msCg;
-    stats.ms.part(StagePart::garmentIntegrate) += r.msIntegrate;
-    stats.ms.part(StagePart::garmentSelfContact) += r.msSelfContact;
+    stepPiece(model, state, s, k, {saturation, velocityChange, poses, colliderKeys}, h, stats);
   }
   if (!model.hasImplicitCloth()) return;
   // remember where the solve put the implicit cloth, so the coupling's push can become velocity

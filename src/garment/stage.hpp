@@ -29,6 +29,9 @@ struct GarmentScratch {
   std::vector<float> fraction;           // a piece's S / S^MAX when Shao's wetting is on
   std::vector<int> soakOrder;            // the vertices a drop soaks into, nearest first
   std::vector<uint8_t> soakSeen;         // per cloth particle, during one drop's soak
+  std::vector<Vec3> startX, startV, startDv;  // a piece's x, v and last dv at its step's start (stepPiece)
+  std::vector<ColliderPose> partPoses;        // the colliders at the end of a halved step's part
+  std::vector<ImplicitStats> steps;           // the statistics of the piece's steps at the last halving
 };
 
 // the cloth triangles near each water particle's path this substep (the coupling's candidates,
@@ -43,7 +46,28 @@ struct DropCandidates {
 // garment.saturationMass, then runs garmentSubstep (Eq. 1-5, wrinkles, contact with wet friction)
 // for every implicit piece, writing its xPred and v. poses are the colliders at state.time + h.
 void solveGarments(const Model& model, State& state, GarmentScratch& s, const std::vector<ColliderPose>& poses,
-                   float h, StepStats& stats);
+                   std::span<const std::vector<Keyframe>> colliderKeys, float h, StepStats& stats);
+
+// the halvings of an implicit step that left a vertex faster than solver.maxSpeed: redone as 2, then
+// 4, then 8 steps (stepPiece)
+constexpr int kMaxHalvings = 3;
+
+// what stepPiece needs of the substep: the piece's saturation and warm-start dv (piece-local), the
+// colliders at its end and their keys (the poses of a halved step's parts)
+struct PieceStepInputs {
+  std::span<const float> saturation;
+  std::span<Vec3> velocityChange;
+  const std::vector<ColliderPose>& poses;
+  std::span<const std::vector<Keyframe>> colliderKeys;
+};
+
+// implicit piece k's step of h from state.time (garmentSubstep), its statistics added to stats. A step
+// that leaves one of its vertices faster than solver.maxSpeed (the run would end as diverged) is done
+// again from its start as 2, 4, then up to 2^kMaxHalvings steps, each with the colliders at its own
+// end, until none is (GarmentStats::halvedSteps). The steps dropped count in the CG iterations and the
+// times only; the frame's other statistics are the kept steps' (solves: each of them)
+void stepPiece(const Model& model, State& state, GarmentScratch& s, size_t k, const PieceStepInputs& in, float h,
+               StepStats& stats);
 
 // after the water coupling (Eq. 21), which may have moved implicit cloth: adds that displacement over
 // h to its velocity (updateVelocities moves only water and PBD cloth). A piece whose drops vanish (no Shao

@@ -96,6 +96,7 @@ nlohmann::ordered_json frameStatsJson(const Model& model, const State& state, in
                     {"disturbances", g.disturbances},
                     {"maxStrain", g.maxStrain},
                     {"strainLimited", g.strainLimited},
+                    {"halvedSteps", g.halvedSteps},
                     {"dropsTaken", g.dropsTaken},
                     {"dropsTakenTotal", state.ledger.particlesTakenByCloth},
                     {"wetVertices", wet}};

@@ -40,7 +40,7 @@ void predict(const Model& model, State& state, Workspace& ws, float h, std::span
   predictPositions(model, ws.pbdParticles, state.particles, h);                    // v += dt g, x* = x + dt v
   updateColliderPoses(model, state.time + h, colliderKeys, ws.poses);
   clock.lap(stats.ms.predict);
-  solveGarments(model, state, ws.garment, ws.poses, h, stats);
+  solveGarments(model, state, ws.garment, ws.poses, colliderKeys, h, stats);
   clock.lap(stats.ms.garment);
 }
 

@@ -281,8 +281,9 @@ TEST(GarmentStage, SolveGarmentsSolvesImplicitPiecesAndWeighsPbdOnes) {
   GarmentScratch gs;
   StepStats stats;
   std::vector<ColliderPose> poses;
-  solveGarments(m, s.state, gs, poses, 0.01f, stats);
+  solveGarments(m, s.state, gs, poses, {}, 0.01f, stats);
   EXPECT_EQ(stats.garment.solves, 1u);
+  EXPECT_EQ(stats.garment.halvedSteps, 0u);  // nothing near solver.maxSpeed
   EXPECT_GT(stats.garment.cgIterations, 0u);
   ASSERT_EQ(gs.solved.size(), size_t(m.numCloth));
   for (int i = 0; i < 25; ++i) EXPECT_EQ(gs.solved[size_t(i)], p.xPred[size_t(i)]) << i;
@@ -601,6 +602,59 @@ TEST(GarmentRun, SameStateForOneAndTwoThreads) {
   const uint64_t two = hashWith(2);
   setThreadCount(2);
   EXPECT_EQ(one, two);
+}
+
+}  // namespace
+}  // namespace soak
+
+namespace soak {
+namespace {
+
+using testing::fromString;
+
+// an implicit sheet hung by two corners, no water
+const char* kHung = R"({
+  "solver": {"dt": 0.01, "domain": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
+  "cloth": [{"name": "sheet", "solver": "implicit", "fabric": "cotton",
+             "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.2, 0.2], "resolution": [5, 5]},
+             "material": {"particleMass": 2e-4}, "pin": {"corners": [0, 1]}}]
+})";
+
+// A step that leaves a vertex faster than solver.maxSpeed is redone from its start as 2, 4, then 8
+// steps: with maxSpeed 5 cm/s every try of the first step's fall from rest is too fast (about g h =
+// 9.8 cm/s), so all three halvings run, and what is left is exactly 8 steps of h/8 chained from the
+// start, the positions at the start kept for the commit
+TEST(GarmentStage, AStepFasterThanMaxSpeedIsRedoneInSmallerSteps) {
+  Scene s = fromString(kHung, {"solver.maxSpeed=0.05"});
+  Scene ref = fromString(kHung, {"solver.maxSpeed=0.05"});
+  const Model& m = s.model;
+  Particles& p = s.state.particles;
+  p.xPred = p.x;
+  const std::vector<Vec3> x0 = p.x;
+  GarmentScratch gs;
+  StepStats stats;
+  const std::vector<ColliderPose> poses;
+  const float h = 0.01f;
+  solveGarments(m, s.state, gs, poses, {}, h, stats);
+  EXPECT_EQ(stats.garment.halvedSteps, unsigned(kMaxHalvings));
+  EXPECT_EQ(stats.garment.solves, 8u);  // the steps kept
+  EXPECT_EQ(p.x, x0);
+
+  Particles& q = ref.state.particles;
+  ImplicitScratch w;
+  const ClothPiece& piece = ref.model.pieces[0];
+  uint64_t iterations = 0;  // of the kept steps; the CG count has the dropped ones' too
+  for (int part = 0; part < 8; ++part) {
+    if (part > 0) q.x = q.xPred;
+    iterations += garmentSubstep(ref.model, *piece.implicit, piece.garment, {}, h / 8, part * double(h / 8), 0, poses,
+                                 q, w, {}).cgIterations;
+  }
+  EXPECT_GT(stats.garment.cgIterations, iterations);
+  for (int i = 0; i < m.numCloth; ++i) {
+    EXPECT_EQ(p.xPred[size_t(i)], q.xPred[size_t(i)]) << i;
+    EXPECT_EQ(p.v[size_t(i)], q.v[size_t(i)]) << i;
+  }
+  EXPECT_GT(p.v[12].norm(), 0.05f);  // still too fast after the last halving: the run's check ends it
 }
 
 }  // namespace

@@ -168,6 +168,7 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   s.garment.dropsTaken = 4;
   s.garment.maxStrain = 0.05f;
   s.garment.strainLimited = 3;
+  s.garment.halvedSteps = 1;
   fs.add(s);
   s.garment.maxStrain = 0.02f;
   fs.add(s);
@@ -180,6 +181,7 @@ TEST(IoStats, WettingAndGarmentSectionsOnlyWhenTheirModelsAreOn) {
   EXPECT_EQ(j["garment"]["cgIterationsMax"], 17);
   EXPECT_FLOAT_EQ(j["garment"]["maxStrain"].get<float>(), 0.05f);  // the largest, not a sum
   EXPECT_EQ(j["garment"]["strainLimited"], 6);
+  EXPECT_EQ(j["garment"]["halvedSteps"], 2);
   EXPECT_EQ(j["garment"]["dropsTaken"], 8);
   EXPECT_EQ(j["garment"]["dropsTakenTotal"], 11);
   EXPECT_EQ(j["garment"]["wetVertices"], 2);
