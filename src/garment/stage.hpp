@@ -43,8 +43,9 @@ struct DropCandidates {
 // before the PBD stages, after predictPositions (which moves only water and PBD cloth): advances the
 // saturation of the pieces with wetByContact to state.time + h (updateSaturation; with Shao's wetting
 // on its S / S^MAX is used instead), sets the Eq. 15-19 mass of every piece with
-// garment.saturationMass, then runs garmentSubstep (Eq. 1-5, wrinkles, contact with wet friction)
-// for every implicit piece, writing its xPred and v. poses are the colliders at state.time + h.
+// garment.saturationMass, then steps every implicit piece (stepPiece: garmentSubstep, Eq. 1-5,
+// wrinkles, contact with wet friction), writing its xPred and v. poses are the colliders at
+// state.time + h; colliderKeys override their keys, as in step() (empty: the model's).
 void solveGarments(const Model& model, State& state, GarmentScratch& s, const std::vector<ColliderPose>& poses,
                    std::span<const std::vector<Keyframe>> colliderKeys, float h, StepStats& stats);
 
