@@ -604,14 +604,6 @@ TEST(GarmentRun, SameStateForOneAndTwoThreads) {
   EXPECT_EQ(one, two);
 }
 
-}  // namespace
-}  // namespace soak
-
-namespace soak {
-namespace {
-
-using testing::fromString;
-
 // an implicit sheet hung by two corners, no water
 const char* kHung = R"({
   "solver": {"dt": 0.01, "domain": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
