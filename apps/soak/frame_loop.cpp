@@ -104,6 +104,13 @@ void printRunSummary(const Scene& scene, const std::string& outDir, int firstFra
     std::printf("soak: solver %.2f ms a step (frames not written), of which wetting %.2f (%s)\n", r.ms.total / steps,
                 r.ms.wetting / steps, parts.c_str());
   }
+  if (model.hasImplicitCloth() && r.garment.solves > 0) {
+    const GarmentStats& g = r.garment;
+    std::printf("soak: garments: %llu implicit steps, %.1f CG iterations a step, %llu stopped at the iteration cap, "
+                "%llu redone in shorter steps (a vertex past solver.maxSpeed)\n",
+                static_cast<unsigned long long>(g.solves), static_cast<double>(g.cgIterations) / g.solves,
+                static_cast<unsigned long long>(g.unconverged), static_cast<unsigned long long>(g.halvedSteps));
+  }
   std::printf("soak: water: emitted %.6g kg = free %.6g kg + held by the cloth %.6g kg + in buffers %.6g kg + "
               "removed at bounds %.6g kg (%llu particles) + taken in by garments %.6g kg; unaccounted %.3g kg\n",
               w.emitted, w.free, w.heldInCloth, w.inBuffers, w.removedAtBounds,
@@ -157,6 +164,7 @@ FrameLoopResult simulateFrames(Scene& scene, const FrameLoop& loop, const fs::pa
         step(model, state, *ws, model.solver.dt, st);
         fs.add(st);
         result.ms += st.ms;
+        result.garment += st.garment;
         ++result.steps;
       }
       const std::string bad = checkState(model, state);
@@ -168,6 +176,10 @@ FrameLoopResult simulateFrames(Scene& scene, const FrameLoop& loop, const fs::pa
         progress.finish();
         record.write("diverged", frame + 1, state);
         reportDivergence(dir, frame, state, bad);
+        if (fs.garment.halvedSteps > 0)
+          std::fprintf(stderr, "soak: the frame's implicit garment steps were redone in shorter steps %llu times first "
+                               "(docs/garment.md, departure 4)\n",
+                       static_cast<unsigned long long>(fs.garment.halvedSteps));
         result.exitCode = kExitDiverged;
         return result;
       }

@@ -3,6 +3,7 @@
 #pragma once
 #include <soak/output.hpp>
 #include <soak/scene.hpp>
+#include <soak/stats.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -46,6 +47,7 @@ struct FrameLoopResult {
   StageTimes ms;            // summed over this loop, for the summary's wetting line
   double simSeconds = 0.0;  // wall time from the first step to the last frame written
   uint64_t steps = 0;       // steps this loop took
+  GarmentStats garment;     // the implicit garments' statistics summed over this loop, for the summary
 };
 
 // a file `soak run` writes into its folder (frames, stats.jsonl, scene.json, run.json,

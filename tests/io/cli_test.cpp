@@ -124,6 +124,36 @@ TEST(CliRun, DivergenceWritesTheBadFrameAndExitsTwo) {
   EXPECT_EQ(nlohmann::json::parse(readTextFile((out / "run.json").string()))["status"], "diverged");
 }
 
+// an implicit 5 x 5 sheet hung by two corners, 3 frames of one step
+constexpr const char* kHungGarment = R"({
+  "solver": {"dt": 0.01, "domain": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
+  "output": {"frames": 3, "stepsPerFrame": 1},
+  "cloth": [{"name": "sheet", "solver": "implicit", "fabric": "cotton",
+             "mesh": {"type": "rectangle", "center": [0, 1, 0], "size": [0.2, 0.2], "resolution": [5, 5]},
+             "material": {"particleMass": 2e-4}, "pin": {"corners": [0, 1]}}]
+})";
+
+// the summary counts the implicit steps, their iterations, the capped and the halved ones; a run that
+// diverges after halving its garment steps says so
+TEST(CliRun, GarmentRunsSummariseTheirSolvesAndHalvings) {
+  const Cli cli("garment");
+  const std::string scene = cli.writeScene("hung.json", kHungGarment);
+  Result r = cli.run("run '" + scene + "' -o '" + (cli.dir() / "ok").string() + "' --threads 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("soak: garments: 3 implicit steps"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 stopped at the iteration cap, 0 redone in shorter steps"), std::string::npos) << r.out;
+
+  // falling from rest, every try of the first step passes 5 cm/s: halved three times, then stopped
+  const fs::path out = cli.dir() / "fast";
+  r = cli.run("run '" + scene + "' -o '" + out.string() + "' --threads 1 --set solver.maxSpeed=0.05");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("redone in shorter steps 3 times first"), std::string::npos) << r.err;
+  const auto lines = readJsonLines(out / "stats.jsonl");
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[1]["garment"]["halvedSteps"], 3);
+  EXPECT_EQ(lines[1]["garment"]["solves"], 8);
+}
+
 TEST(CliValidate, EveryShippedSceneIsValid) {
   const Cli cli("validate");
   int scenes = 0;
