@@ -36,7 +36,7 @@ struct StageTimes {         // ms of wall time per stage
 
 // the implicit garment solves of Chen 2012 (src/garment), summed over substeps and pieces
 struct GarmentStats {
-  uint64_t solves = 0;          // implicit steps taken (pieces x substeps)
+  uint64_t solves = 0;          // implicit steps taken (pieces x substeps; each part of a halved step)
   uint64_t cgIterations = 0;    // summed over the solves
   int cgIterationsMax = 0;
   double maxResidual = 0.0;     // largest relative CG residual at exit

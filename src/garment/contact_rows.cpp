@@ -214,5 +214,4 @@ void solveWithContact(const GarmentParams& params, std::span<const Vec3> v0, Imp
   }
 }
 
-
 }  // namespace soak

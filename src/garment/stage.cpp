@@ -268,8 +268,7 @@ void stepPiece(const Model& model, State& state, GarmentScratch& s, size_t k, co
     s.steps.push_back(garmentSubstep(model, *piece.implicit, piece.garment, in.saturation, hp, time, state.stepCount,
                                      poses, p, s.scratch[k], in.velocityChange));
   };
-  s.startX.assign(p.x.begin() + first, p.x.begin() + first + n);
-  s.startV.assign(p.v.begin() + first, p.v.begin() + first + n);
+  s.startV.assign(p.v.begin() + first, p.v.begin() + first + n);  // the step overwrites v, not x
   s.startDv.assign(in.velocityChange.begin(), in.velocityChange.end());
   s.steps.clear();
   run(h, state.time, in.poses);
@@ -279,6 +278,7 @@ void stepPiece(const Model& model, State& state, GarmentScratch& s, size_t k, co
     for (const ImplicitStats& r : s.steps) addStepCost(r, stats);  // the steps dropped
     s.steps.clear();
     ++stats.garment.halvedSteps;
+    if (level == 1) s.startX.assign(p.x.begin() + first, p.x.begin() + first + n);  // the parts move x on
     const int parts = 1 << level;
     const float hp = h / static_cast<float>(parts);
     std::copy(s.startV.begin(), s.startV.end(), p.v.begin() + first);

@@ -29,7 +29,7 @@ struct GarmentScratch {
   std::vector<float> fraction;           // a piece's S / S^MAX when Shao's wetting is on
   std::vector<int> soakOrder;            // the vertices a drop soaks into, nearest first
   std::vector<uint8_t> soakSeen;         // per cloth particle, during one drop's soak
-  std::vector<Vec3> startX, startV, startDv;  // a piece's x, v and last dv at its step's start (stepPiece)
+  std::vector<Vec3> startX, startV, startDv;  // a piece's x (once halving), v and last dv at its step's start
   std::vector<ColliderPose> partPoses;        // the colliders at the end of a halved step's part
   std::vector<ImplicitStats> steps;           // the statistics of the piece's steps at the last halving
 };
