@@ -28,6 +28,7 @@ struct WaterParams {
   float relaxation = 0.1f;        // CFM epsilon of PBF's lambda (Macklin 2013 Eq. 11), in units of w_i / h_i^2
   float viscosity = 0.02f;        // XSPH coefficient c (Macklin 2013 Eq. 17), with volume-weighted W
   float vorticity = 0.0f;         // vorticity confinement epsilon (Macklin 2013 Eq. 16), m/s^2 scale
+  float hyperviscosity = 50.0f;   // 1/s: v -= (rate h) L(L v) a substep, L the XSPH sum: damps particle-scale noise (docs/models.md)
   float tensileK = 0.0f;          // artificial pressure k (Macklin 2013 Eq. 13); off: see docs/models.md on Eq. 6
   float tensileDq = 0.2f;         // artificial pressure delta q, as a fraction of h
   int tensileN = 4;               // artificial pressure exponent n

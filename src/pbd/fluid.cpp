@@ -304,6 +304,7 @@ struct VelocityPass {
   pbf::PairKernel<float> kU;  // the kernel of the common radius
   float viscosity;
   int64_t nc;
+  bool keepSum;  // the hyperviscosity follows: each particle's XSPH sum (L v) to s.velocitySum
 };
 
 // one water particle's XSPH velocity (Macklin 2013 Eq. 17, weighted by V_ij) to s.delta and, with
@@ -338,7 +339,30 @@ void xsphOf(const VelocityPass& c, size_t i) {
     }
   }
   if (Vort) c.s.vorticity[i] = Vec3(ox, oy, oz);
+  if (c.keepSum) c.s.velocitySum[i] = Vec3(bx, by, bz);
   c.s.delta[i] = Vec3(vxi, vyi, vzi) + c.viscosity * Vec3(bx, by, bz);
+}
+
+// the hyperviscosity's second sum (docs/models.md, "Hyperviscosity"): with b = L v the XSPH sums of the
+// first pass, delta_i -= k sum_j V_ij W_ij (b_j - b_i), the same weights as xsphOf's, so that
+// sum_i m_i dv_i = 0 and a velocity field linear in position (L v = 0 where the support is full) is kept
+template <bool U>
+void hyperviscosityOf(const VelocityPass& c, size_t i, float k) {
+  const float* X = c.p.xPred[0].data();
+  const float* H = c.p.radius.data();
+  const float* D = c.s.density.data();
+  const Vec3* B = c.s.velocitySum.data();
+  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
+  Vec3 sum = Vec3::Zero();
+  for (uint32_t n = c.nb.waterBegin(i, static_cast<uint32_t>(c.nc)); n < c.nb.start[i + 1]; ++n) {
+    const uint32_t j = c.nb.index[n];
+    if (c.p.phase[j] != kWaterPhase) continue;
+    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+    const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(pairRadius(hi, H[j]), 1.0f / pairRadius(hi, H[j]));
+    const float vol = 2.0f * c.p.mass[j] / std::max(di + D[j], 1e-3f);
+    sum += (vol * pbf::poly6Value(kernel, rx * rx + ry * ry + rz * rz)) * (B[j] - B[i]);
+  }
+  c.s.delta[i] -= k * sum;
 }
 
 // vorticity confinement, f = epsilon (N x omega), N = eta / |eta|, eta = grad |omega| (Macklin 2013
@@ -381,9 +405,11 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
   const size_t n = p.size();
   const int64_t nc = model.numCloth;
   const int64_t nw = static_cast<int64_t>(n) - nc;
-  if (nw <= 0 || (wp.viscosity <= 0.0f && wp.vorticity <= 0.0f)) return;
+  const float k = hyperviscosityStep(wp.hyperviscosity, dt);
+  if (nw <= 0 || (wp.viscosity <= 0.0f && wp.vorticity <= 0.0f && k <= 0.0f)) return;
   s.delta.resize(n);  // the new velocities: the solver's corrections are spent, their memory reused
   s.vorticity.resize(n);
+  if (k > 0.0f) s.velocitySum.resize(n);
   // compile-time flags: every radius equal (the kernel's constants are loop constants, as in
   // solveFluid), vorticity wanted
   float hU = 0.0f;
@@ -394,7 +420,7 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
     hU = wp.supportRadius;
     if (!listsOfSolve) markNeighbourhoods(p, nb, nc, wp.particleMass, hU, &s.mixedRadius, nullptr);
   }
-  const VelocityPass c{p, nb, s, s.mixedRadius.data(), pbf::pairKernel(hU, 1.0f / hU), wp.viscosity, nc};
+  const VelocityPass c{p, nb, s, s.mixedRadius.data(), pbf::pairKernel(hU, 1.0f / hU), wp.viscosity, nc, k > 0.0f};
   withFlags(uniform, wp.vorticity > 0.0f, [&](auto uniform, auto vortex) {
     constexpr bool Vort = decltype(vortex)::value;
     parallelFor(nw, [&](int64_t w) {
@@ -406,6 +432,15 @@ void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb
     });
   });
   if (wp.vorticity > 0.0f) confineVorticity(c, wp.vorticity, dt);
+  if (k > 0.0f) {
+    parallelFor(nw, [&](int64_t w) {
+      const size_t i = static_cast<size_t>(nc + w);
+      if (uniform || !c.mixed[i])
+        hyperviscosityOf<true>(c, i, k);
+      else
+        hyperviscosityOf<false>(c, i, k);
+    });
+  }
   parallelFor(nw, [&](int64_t w) { p.v[nc + w] = s.delta[nc + w]; });
 }
 

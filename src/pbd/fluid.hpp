@@ -8,6 +8,7 @@
 #include "pbd/boundary.hpp"
 #include "world/colliders.hpp"
 
+#include <algorithm>
 #include <vector>
 
 namespace soak {
@@ -18,6 +19,7 @@ struct FluidScratch {
   std::vector<float> lambda;       // m^2, lambda_i / m_i of the density constraint
   std::vector<Vec3> delta;         // m, position corrections of the current iteration; m/s, velocities after XSPH
   std::vector<Vec3> vorticity;     // 1/s, omega_i
+  std::vector<Vec3> velocitySum;   // m/s, each water particle's XSPH sum sum_j V_ij W_ij (v_j - v_i) = L v (hyperviscosity)
   std::vector<float> vorticityNorm; // 1/s, |omega_i| (0 for cloth)
   std::vector<float> massOrPsi;    // kg, what a neighbour lends the density: m_j (water) or Psi_j (cloth)
   float sCorrScale = 0.0f;         // m^2, lambda scale of the artificial pressure
@@ -56,7 +58,14 @@ inline bool stopIterating(double compression, double tolerance, int taken, int l
 // mean over the water particles of max(rho_i / rho_0 - 1, 0), from the densities of the last lambda pass
 double meanCompression(const Model& model, const FluidScratch& s);
 
-// XSPH viscosity and vorticity confinement on water velocities (after v = (x* - x)/dt).
+// the hyperviscosity's coefficient for a substep of h: rate h, at most kMaxHyperviscosityStep. A mode
+// that L (the XSPH sum) scales by -mu keeps 1 - k mu^2 of itself a substep; mu is at most twice a row's
+// weight sum sum_j V_ij W_ij < 1 (Gershgorin), so k <= 0.5 never amplifies one (about 1.1 in settled water)
+constexpr float kMaxHyperviscosityStep = 0.4f;
+inline float hyperviscosityStep(float rate, float h) { return std::min(rate * h, kMaxHyperviscosityStep); }
+
+// XSPH viscosity, vorticity confinement and the hyperviscosity (v -= k L(L v), docs/models.md) on water
+// velocities (after v = (x* - x)/dt).
 // listsOfSolve: nb are the lists solveFluid last ran on with s, and no radius has changed since, so its
 // mixed-radius flags (s.mixedRadius) hold; false marks them again
 void fluidVelocityPass(const Model& model, Particles& p, const NeighborLists& nb, FluidScratch& s, float dt,

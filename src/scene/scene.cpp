@@ -133,6 +133,7 @@ void readWater(ObjectReader r, WaterParams& w) {
   w.relaxation = r.number("relaxation", d.relaxation, Range::positive());
   w.viscosity = r.number("viscosity", d.viscosity, Range::unit());
   w.vorticity = r.number("vorticity", d.vorticity, Range::nonNegative());
+  w.hyperviscosity = r.number("hyperviscosity", d.hyperviscosity, Range::nonNegative());
   ObjectReader t = r.object("tensile");
   w.tensileK = t.number("k", d.tensileK, Range::nonNegative());
   w.tensileDq = t.number("dq", d.tensileDq, Range{0.0, 1.0, false, true});

@@ -297,7 +297,7 @@ TEST(Fluid, SolverPassMatchesPairByPairReference) {
 
 TEST(Fluid, XsphMatchesPairByPairReference) {
   // the XSPH pass against a double-precision pair loop of Macklin 2013 Eq. 17 with soak's volume
-  // weights 2 m_j / (rho_i + rho_j), equal radii, every other one shrunk, and one shrunk (its
+  // weights 2 m_j / (rho_i + rho_j), and the hyperviscosity's second sum of the same weights; equal radii, every other one shrunk, and one shrunk (its
   // neighbours take the per-pair radius, the others the constant one); scalar: 16-lane gathers were slower.
   // Cases 0 - 2 take the flags solveFluid marked on the same lists. Cases 3 and 4: the solver marked
   // lists where one particle was shrunk, then another one is shrunk instead and the lists are built
@@ -329,16 +329,26 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
     }
     const std::vector<Vec3> v0 = p.v;
     fluidVelocityPass(model, p, lists, s, 0.015f, mixed < 3);  // 3, 4: not the lists solveFluid marked
+    // L u_i = sum_j V_ij W_ij (u_j - u_i); the pass adds c L v (XSPH) and takes k L(L v) (hyperviscosity)
+    const auto smooth = [&](const std::vector<Eigen::Vector3d>& u) {
+      std::vector<Eigen::Vector3d> out(p.size(), Eigen::Vector3d::Zero());
+      for (size_t i = nc; i < p.size(); ++i)
+        for (uint32_t k = lists.waterBegin(i, static_cast<uint32_t>(nc)); k < lists.start[i + 1]; ++k) {
+          const uint32_t j = lists.index[k];
+          const double vol = 2.0 * p.mass[j] / std::max(double(s.density[i]) + s.density[j], 1e-3);
+          const double w = poly6((p.xPred[i] - p.xPred[j]).squaredNorm(), pairRadius(p.radius[i], p.radius[j]));
+          out[i] += vol * w * (u[j] - u[i]);
+        }
+      return out;
+    };
+    std::vector<Eigen::Vector3d> u(p.size());
+    for (size_t i = 0; i < p.size(); ++i) u[i] = v0[i].cast<double>();
+    const std::vector<Eigen::Vector3d> b = smooth(u), e = smooth(b);
+    const double k = hyperviscosityStep(model.water.hyperviscosity, 0.015f);
+    ASSERT_GT(k, 0.0);
     float worst = 0.0f, largest = 0.0f;
     for (size_t i = nc; i < p.size(); ++i) {
-      Eigen::Vector3d b = Eigen::Vector3d::Zero();
-      for (uint32_t k = lists.waterBegin(i, static_cast<uint32_t>(nc)); k < lists.start[i + 1]; ++k) {
-        const uint32_t j = lists.index[k];
-        const double vol = 2.0 * p.mass[j] / std::max(double(s.density[i]) + s.density[j], 1e-3);
-        const double w = poly6((p.xPred[i] - p.xPred[j]).squaredNorm(), pairRadius(p.radius[i], p.radius[j]));
-        b += vol * w * (v0[j] - v0[i]).cast<double>();
-      }
-      const Vec3 dv = (model.water.viscosity * b).cast<float>();
+      const Vec3 dv = (model.water.viscosity * b[i] - k * e[i]).cast<float>();
       largest = std::max(largest, dv.norm());
       worst = std::max(worst, (p.v[i] - v0[i] - dv).norm());
     }
@@ -346,4 +356,87 @@ TEST(Fluid, XsphMatchesPairByPairReference) {
     const char* what[] = {"equal radii", "mixed radii", "one shrunk", "lists built again", "lists built in a fresh object"};
     EXPECT_LT(worst, 1e-4f * largest) << what[mixed];
   }
+}
+
+namespace {
+// the kinetic energy sum m v^2 / 2 of the water particles selected by keep(i)
+double kineticOf(const Particles& p, size_t first, const std::function<bool(size_t)>& keep) {
+  double e = 0.0;
+  for (size_t i = first; i < p.size(); ++i)
+    if (keep(i)) e += 0.5 * p.mass[i] * p.v[i].cast<double>().squaredNorm();
+  return e;
+}
+}  // namespace
+
+TEST(Fluid, HyperviscosityDampsParticleNoiseAndKeepsSmoothFlow) {
+  // a 0.4 x 0.2 x 0.2 m lattice block of water, no gravity, given three velocity fields in turn: a
+  // checkerboard (the particle-scale noise a density solve leaves), a wave one block long and a
+  // uniform shear. One velocity pass with the hyperviscosity only, against XSPH alone at the
+  // coefficient that damps the checkerboard as much: the hyperviscosity (k L(L v), docs/models.md) must
+  // leave the wave 5 times less damped, and the shear untouched away from the surface
+  Scene scene = sceneFromJson(R"({
+    "solver": {"gravity": [0, 0, 0], "fluidIterations": 1, "domain": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
+    "emitters": [{"type": "block", "min": [-0.2, 0.0, -0.1], "max": [0.2, 0.2, 0.1]}]
+  })");
+  runSteps(scene, 1);
+  Model& model = scene.model;
+  Particles& p = scene.state.particles;
+  ASSERT_EQ(p.size(), 2000u);
+  p.xPred = p.x;
+  NeighborGrid grid;
+  NeighborLists nb;
+  buildGrid(p.xPred, maxSupportRadius(p), grid);
+  buildNeighborLists(p.xPred, p.radius, grid, nb);
+  FluidScratch s;
+  computeBoundaryPsi(model, p, nb, s);
+  solveFluid(model, {}, p, nb, s, 1);  // the densities the pass reads
+  p.xPred = p.x;
+  const float h = 0.0075f, spacing = model.water.spacing, support = model.water.supportRadius;
+  const auto cell = [&](size_t i, int axis) {
+    return static_cast<int>(std::lround((p.x[i][axis] - (axis == 0 ? -0.2f : axis == 1 ? 0.0f : -0.1f)) / spacing - 0.5f));
+  };
+  const auto inside = [&](size_t i) {  // two supports from every face: a full neighbourhood of full ones
+    const Vec3 lo(-0.2f, 0.0f, -0.1f), hi(0.2f, 0.2f, 0.1f);
+    return ((p.x[i] - lo).minCoeff() > 2.0f * support) && ((hi - p.x[i]).minCoeff() > 2.0f * support);
+  };
+  const auto all = [](size_t) { return true; };
+  enum Field { Checkerboard, Wave, Shear };
+  // the ratio of the selected particles' kinetic energy after one pass to before, and the largest
+  // change of an inside particle's velocity
+  const auto pass = [&](Field field, float viscosity, float hyperviscosity, float* largestInside = nullptr) {
+    for (size_t i = 0; i < p.size(); ++i) {
+      const int sign = (cell(i, 0) + cell(i, 1) + cell(i, 2)) % 2 == 0 ? 1 : -1;
+      p.v[i] = field == Checkerboard ? Vec3(0.0f, 0.1f * float(sign), 0.0f)
+               : field == Wave       ? Vec3(0.0f, 0.1f * std::sin(2.0f * kPi * p.x[i].x() / 0.4f), 0.0f)
+                                     : Vec3(0.5f * p.x[i].y(), 0.0f, 0.0f);
+    }
+    const std::vector<Vec3> before = p.v;
+    const double e0 = kineticOf(p, 0, all);
+    model.water.viscosity = viscosity;
+    model.water.hyperviscosity = hyperviscosity;
+    fluidVelocityPass(model, p, nb, s, h, true);
+    if (largestInside) {
+      *largestInside = 0.0f;
+      for (size_t i = 0; i < p.size(); ++i)
+        if (inside(i)) *largestInside = std::max(*largestInside, (p.v[i] - before[i]).norm());
+    }
+    return kineticOf(p, 0, all) / e0;
+  };
+  const float rate = 50.0f;  // k = 0.375 at h
+  EXPECT_FLOAT_EQ(hyperviscosityStep(rate, h), 0.375f);
+  EXPECT_FLOAT_EQ(hyperviscosityStep(rate, 0.03f), kMaxHyperviscosityStep);  // a long substep: capped
+  const double hyperNoise = pass(Checkerboard, 0.0f, rate), hyperWave = pass(Wave, 0.0f, rate);
+  EXPECT_LT(hyperNoise, 0.7);  // the noise loses at least 30% of its energy in one pass
+  // XSPH alone at the coefficient with the same damping of the checkerboard (bisection)
+  float lo = 0.0f, hi = 1.0f;
+  for (int it = 0; it < 30; ++it) {
+    const float c = 0.5f * (lo + hi);
+    (pass(Checkerboard, c, 0.0f) > hyperNoise ? lo : hi) = c;
+  }
+  const double xsphWave = pass(Wave, 0.5f * (lo + hi), 0.0f);
+  EXPECT_GT(1.0 - xsphWave, 5.0 * (1.0 - hyperWave)) << "hyperviscosity " << hyperWave << ", XSPH " << xsphWave;
+  EXPECT_GT(1.0 - hyperWave, 0.0);  // it does act on the wave, a little
+  float shearChange = 0.0f;
+  pass(Shear, 0.0f, rate, &shearChange);
+  EXPECT_LT(shearChange, 1e-3f * 0.5f * 0.2f) << "a linear velocity field is kept inside";
 }

@@ -237,6 +237,10 @@ TEST(SceneErrors, AllErrorsAreReportedTogether) {
   EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 2);
 }
 
+TEST(SceneErrors, NegativeHyperviscosityIsRefused) {
+  EXPECT_HAS(loadError(kSmall, {"water.hyperviscosity=-1"}), "at water.hyperviscosity: expected a number >= 0, got -1");
+}
+
 TEST(SceneErrors, LongErrorListsAreCut) {
   std::string many = "[";
   for (int i = 0; i < 80; ++i) many += (i ? ", " : "") + std::to_string(100 + i);
