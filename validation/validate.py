@@ -49,8 +49,9 @@ def dam_break(work):
     Martin & Moyce scale time as T = n t sqrt(g/a) with n^2 = height / width: T = t sqrt(g/a) for the
     square column (t sqrt(2g/a) is their n^2 = 2 column's, and applied to these data shows a false 25% lag).
     The worst point is their second, T = 0.62, where the measured front is slowest (Z rises by 0.58 per
-    unit T before it and 1.22 after: the gate's opening): one substep is 11.0% ahead there and within
-    8.2% at every other point; the viscosity does not move it (water.viscosity doubled: 11.0%)."""
+    unit T before it and 1.22 after: the gate's opening): one substep is 10.2% ahead there and within
+    7.1% at every other point; the viscosity does not move it (water.viscosity doubled: 10.1%).
+    Without the hyperviscosity (docs/models.md) 11.0%, 6.9% and 9.6% at 1, 2 and 4 substeps."""
     a, x0 = 0.3, -0.9
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(MARTIN_MOYCE[:, 0], MARTIN_MOYCE[:, 1], "ko", label="Martin & Moyce 1952")
@@ -78,9 +79,9 @@ def dam_break(work):
 def rest(work):
     """a settled block: kinetic energy below 1e-3 J per 10k particles within 3 s, density within 1% of 1.
     The density solve stops at a 1% mean compression (solver.fluidTolerance); what kinetic energy it
-    leaves is particle-scale noise spread through the block, which grows the further the solve goes
-    (8, 16, 32, 64 fixed iterations: 0.020, 0.018, 0.050, 0.12 J at 3 s; 4: 0.24 J, 2.9% compressed):
-    docs/models.md, "Eq. 6-7 iterated to a tolerance", has the measurements and what was tried."""
+    leaves is particle-scale noise spread through the block, which the hyperviscosity damps (without
+    it 0.018 J at 3 s): docs/models.md, "Eq. 6-7 iterated to a tolerance" and "Hyperviscosity", has the
+    measurements and what was tried."""
     out = soakrun.run(os.path.join(HERE, "rest_block.json"), os.path.join(work, "rest"))
     t, ke, rho, its = [], [], [], []
     for s, w in water_frames(out):
