@@ -2,7 +2,12 @@
 (validation/hanging_cloth.json). Targets of issue 22 point 4: at rest the largest edge strain <= 3% and
 its 99th percentile <= 1%; <= 5% under a heavy water load; <= 10% with the tethers off; the energy never
 rises at rest; and the hanging shape against a converged reference (the same scene at 16 times the
-cloth small steps, 4 iterations each, no tethers). run(work, save) -> (rows, plot)."""
+cloth small steps, 4 iterations each, no tethers). The energy is kinetic plus potential: it leaves out
+the residual stretch's elastic energy, which the sheet, released from its unstretched shape, trades
+with its motion as any spring released at its rest length does (down to twice the static stretch and
+back: the sum rises by the weight times that stretch). Counted as springs of the solve's stiffness
+(measure()), the stretch takes most of the rise out of the sum; once the release's swing has died
+down (1 s) the sum alone no longer rises. run(work, save) -> (rows, plot)."""
 import json
 import os
 
@@ -19,6 +24,7 @@ SCENE = os.path.join(HERE, "hanging_cloth.json")
 G = 9.81
 FRAMES = 100          # 3 s at 0.03 s a frame: the sheet has stopped swinging
 REST_FRAMES = 10      # "at rest": the last 10 frames (0.3 s)
+REST_FROM = 1.0       # s: the release's swing has died down to the 1e-4 J/kg scale (docs/models.md, Eq. 8)
 NO_TETHERS = "cloth.0.material.tetherSlack=1000"  # a tether 1000 times its rest path never holds
 # the water load: every cloth particle holds water at S = 0.35 (Eq. 10 with c = 2e-4 m^3/kg), kept still
 # (no absorption, diffusion, emission or sticking): 60 kg on the 66 kg sheet. A load spread evenly scales
@@ -52,11 +58,22 @@ def cloth_frames(out):
         yield st[f], soakrun.read_vertices(os.path.join(out, f"cloth_{f:04d}.ply"))
 
 
+def small_step():
+    """s: the cloth's small step in validation/hanging_cloth.json (dt / substeps / clothSubsteps)"""
+    with open(SCENE) as f:
+        solver = json.load(f)["solver"]
+    return solver["dt"] / solver["substeps"] / solver["clothSubsteps"]
+
+
 def measure(out):
-    """per frame: time, edge strain (max, p99), energy per unit mass (kinetic + potential, J/kg), and
-    the first and last frame's positions. Rest lengths are frame 0's (the rest shape)."""
+    """per frame: time, edge strain (max, p99), energy per unit mass (kinetic + potential, J/kg), the
+    residual stretch's energy per unit mass counted as springs of the solve's stiffness (J/kg), and the
+    first and last frame's positions. Rest lengths are frame 0's (the rest shape). The stiffness: one
+    projection a small step h_s holds a force F on an edge whose ends weigh m_a, m_b with a violation
+    F h_s^2 (1/m_a + 1/m_b), so k = 1 / ((1/m_a + 1/m_b) h_s^2) (equal masses, pins weightless)."""
     edges = None
-    t, smax, s99, energy, x, x0 = [], [], [], [], None, None
+    hs = small_step()
+    t, smax, s99, energy, stretch, x, x0 = [], [], [], [], [], None, None
     for s, v in cloth_frames(out):
         x = positions(v)
         if edges is None:
@@ -70,7 +87,10 @@ def measure(out):
         smax.append(float(strain.max()))
         s99.append(float(np.percentile(strain, 99)))
         energy.append(float(np.mean(0.5 * vel2[free] + G * x[free, 1])))  # equal masses: per kg
-    return {"t": np.array(t), "max": np.array(smax), "p99": np.array(s99), "energy": np.array(energy), "x": x, "x0": x0}
+        ends = free[edges[:, 0]].astype(float) + free[edges[:, 1]]  # m (1/m_a + 1/m_b), per unit mass m
+        stretch.append(float(np.sum(0.5 * (strain * rest) ** 2 / (ends * hs * hs)) / np.count_nonzero(free)))
+    return {"t": np.array(t), "max": np.array(smax), "p99": np.array(s99), "energy": np.array(energy),
+            "stretch": np.array(stretch), "x": x, "x0": x0}
 
 
 def at_rest(m):
@@ -111,10 +131,16 @@ def run(work, save):
     rows += strain_rows(f"{held:.0f} kg of water held", runs["water load"], 0.05)
     rows += strain_rows("tethers off", runs["tethers off"], 0.10)
     rows += strain_rows("1 substep of 32 small steps (the same 0.47 ms small steps)", runs["1 substep"], 0.03, 0.01)
-    e = runs["rest"]["energy"]
+    e, t = runs["rest"]["energy"], runs["rest"]["t"]
     rise = float(np.max(np.diff(e))) if len(e) > 1 else 0.0
+    with_stretch = float(np.max(np.diff(e + runs["rest"]["stretch"]))) if len(e) > 1 else 0.0
     rows.append(("hanging cloth: energy from frame to frame", "never rises (by more than 1e-4 J/kg)",
-                 f"largest change {rise:+.2g} J/kg (of a {e[0] - e[-1]:.3g} J/kg drop)", rise <= 1e-4))
+                 f"largest change {rise:+.2g} J/kg (of a {e[0] - e[-1]:.3g} J/kg drop; with the stretch's "
+                 f"energy {with_stretch:+.2g})", rise <= 1e-4))
+    later = t[1:] >= REST_FROM
+    rest_rise = float(np.max(np.diff(e)[later])) if later.any() else 0.0
+    rows.append((f"hanging cloth: energy from frame to frame from {REST_FROM:g} s on (at rest)",
+                 "never rises (by more than 1e-4 J/kg)", f"largest change {rest_rise:+.2g} J/kg", rest_rise <= 1e-4))
     gap = np.linalg.norm(runs["rest"]["x"] - runs["reference"]["x"], axis=1)
     rows.append(("hanging cloth: shape against the converged reference (4x the small steps, 4 iterations, no tethers)",
                  "every particle within 2 cm", f"max {100 * gap.max():.2f} cm, mean {100 * gap.mean():.2f} cm",
