@@ -1,5 +1,5 @@
 // PBD cloth of Shao 2017 section 3.2: stretch (Eq. 8) and bend (Eq. 9) constraints solved with XPBD
-// (Macklin et al. 2016) colour by colour, and particle-particle self-collision.
+// (Macklin et al. 2016) colour by colour; the self-collision is in cloth_self_collision.cpp.
 #include "pbd/cloth.hpp"
 
 #include <algorithm>
@@ -245,60 +245,6 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
       solveGroup(2 * slabs - 1);
     }
   }
-}
-
-// for a pair (i, j) of one piece, not 1-ring neighbours and apart by more than the thickness d at rest,
-// with |x_i - x_j| < d: delta_i += w_i/(w_i + w_j) (d - |x_ij|) x_ij/|x_ij|. Gathered per particle
-// (Jacobi), then applied, so the result does not depend on the thread count.
-void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch) {
-  const int n = model.numCloth;
-  scratch.delta.assign(n, Vec3::Zero());
-  scratch.deltaCount.assign(n, 0);
-  if (n == 0) return;
-  const Vec3* x = p.xPred.data();
-  const float* w = p.invMass.data();
-  const Vec3* rest = model.clothRestPosition.data();
-  Vec3* delta = scratch.delta.data();
-  int* count = scratch.deltaCount.data();
-
-  parallelForDynamic(n, kClothChunk, [&](int64_t ii) {  // folds have more neighbours
-    const int i = static_cast<int>(ii);
-    const int piece = clothPiece(p.phase[i]);
-    if (piece < 0 || piece >= static_cast<int>(model.pieces.size())) return;
-    const ClothMaterial& mat = model.pieces[piece].material;
-    // an implicit piece has its own (garment/self_collision.hpp)
-    if (!mat.selfCollision || w[i] == 0.0f || model.pieces[piece].solver != ClothSolver::Pbd) return;
-    const float thickness = mat.thickness;
-    const auto ringBegin = model.vertexNeighbors.begin() + model.vertexNeighborStart[i];
-    const auto ringEnd = model.vertexNeighbors.begin() + model.vertexNeighborStart[i + 1];
-    Vec3 sum = Vec3::Zero();
-    int contacts = 0;
-    const Vec3 xi = x[i];
-    const float t2 = thickness * thickness;
-    for (uint32_t s = neighbors.start[i], end = neighbors.clothEnd(i, static_cast<uint32_t>(n)); s < end; ++s) {
-      const int j = static_cast<int>(neighbors.index[s]);
-      if (j >= n) continue;
-      // the distance first: nearly every neighbour (within h) is farther than the thickness
-      const Vec3 xij = xi - x[j];
-      const float dist2 = xij.squaredNorm();
-      if (dist2 >= t2 || dist2 < 1e-24f) continue;
-      // the 1-ring next (most of the near pairs: the mesh spacing is about the thickness), from i's own
-      // cached list before j's phase, mass and rest position are loaded
-      if (std::binary_search(ringBegin, ringEnd, j)) continue;
-      if (j == i || p.phase[j] != p.phase[i]) continue;
-      const float wSum = w[i] + w[j];
-      if (wSum == 0.0f) continue;
-      // pairs that are this close at rest belong together (fine meshes, seams): leave them to Eq. 8
-      if ((rest[i] - rest[j]).squaredNorm() <= t2) continue;
-      const float dist = std::sqrt(dist2);
-      sum += (w[i] / wSum * (thickness - dist) / dist) * xij;
-      ++contacts;
-    }
-    delta[i] = sum;
-    count[i] = contacts;
-  });
-  Vec3* xw = p.xPred.data();
-  parallelFor(n, [&](int64_t i) { xw[i] += delta[i]; });
 }
 
 }  // namespace soak

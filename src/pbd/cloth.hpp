@@ -20,8 +20,10 @@ struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
   std::vector<float> correction;      // m, the moves of the stretch constraints' particles, 6 per constraint (SoA)
   std::vector<float> correctionBend;  // m, the same for the bend constraints, 12 per constraint
-  std::vector<Vec3> delta;
-  std::vector<int> deltaCount;
+  std::vector<Vec3> delta;            // m, each particle's self-collision move of a pass
+  std::vector<int> contacts;          // the pairs that pass pushed each particle away from
+  double selfCollisionMs = 0.0;       // the last stepCloth's time in the self-collision (stage timings)
+  std::vector<int> pairCount, pairs;  // CSR: particle i's self-collision pairs are pairs[pairCount[i], pairCount[i + 1])
   std::vector<Vec3> stepPosition, stepVelocity;  // m, m/s: a cloth particle's at the start of a small step
   std::vector<Vec3> velocityOffset;  // m/s: the last small step's velocity minus (x* - x)/h (stepCloth)
 };
@@ -38,13 +40,24 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations);
 
 // the PBD cloth's substep of h: model.solver.clothSubsteps small steps of h/clothSubsteps, each a
-// prediction from the last (v += h_s g, x* = x + h_s v), the tethers and clothIterations iterations
-// of solveCloth (Macklin et al. 2019: substeps converge faster than iterations). Leaves x* at the
-// last small step's end and scratch.velocityOffset for updateVelocities. Moves only free PBD cloth.
-void stepCloth(const Model& model, Particles& p, ClothScratch& scratch, float h);
+// prediction from the last (v += h_s g, x* = x + h_s v), the tethers, clothIterations iterations
+// of solveCloth and the self-collision of the pairs near at the substep's start (Macklin et al. 2019:
+// substeps converge faster than iterations). Leaves x* at the last small step's end and
+// scratch.velocityOffset for updateVelocities. Moves only free PBD cloth. neighbors: the lists of x*.
+void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h);
 
-// pushes apart cloth particles of the same piece closer than its thickness that are not mesh
-// neighbours (Jacobi, gather style: each particle sums its own corrections)
-void clothSelfCollision(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch);
+// pushes apart cloth particles of the same piece closer than its thickness d that are not mesh
+// neighbours nor closer than d at rest: delta_i = sum_j w_i/(w_i + w_j) (d - |x_ij|) x_ij/|x_ij|
+// (Jacobi, gather style: each particle sums its own moves), over all of each particle's neighbours;
+// returns the pairs pushed, each counted from both sides (once where one end is held)
+int clothSelfCollision(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch);
+
+// the pairs clothSelfCollision would consider that are within two thicknesses of each other now,
+// into scratch.pairCount / scratch.pairs (the small steps' candidates)
+void findSelfCollisionPairs(const Model& model, const Particles& p, const NeighborLists& neighbors,
+                            ClothScratch& scratch);
+
+// clothSelfCollision's push over the pairs findSelfCollisionPairs found only; returns as it does
+int collideSelfCollisionPairs(const Model& model, Particles& p, ClothScratch& scratch);
 
 }  // namespace soak

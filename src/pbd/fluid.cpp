@@ -358,7 +358,8 @@ void hyperviscosityOf(const VelocityPass& c, size_t i, float k) {
     const uint32_t j = c.nb.index[n];
     if (c.p.phase[j] != kWaterPhase) continue;
     const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-    const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(pairRadius(hi, H[j]), 1.0f / pairRadius(hi, H[j]));
+    const float h = U ? 0.0f : pairRadius(hi, H[j]);
+    const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(h, 1.0f / h);
     const float vol = 2.0f * c.p.mass[j] / std::max(di + D[j], 1e-3f);
     sum += (vol * pbf::poly6Value(kernel, rx * rx + ry * ry + rz * rz)) * (B[j] - B[i]);
   }

@@ -60,7 +60,8 @@ double meanCompression(const Model& model, const FluidScratch& s);
 
 // the hyperviscosity's coefficient for a substep of h: rate h, at most kMaxHyperviscosityStep. A mode
 // that L (the XSPH sum) scales by -mu keeps 1 - k mu^2 of itself a substep; mu is at most twice a row's
-// weight sum sum_j V_ij W_ij < 1 (Gershgorin), so k <= 0.5 never amplifies one (about 1.1 in settled water)
+// weight sum sum_j V_ij W_ij < 1 (Gershgorin), so k <= 0.5 never amplifies one (about 1.1 in settled water);
+// 0.4: at 0.45-0.5 a block dropped at one substep of 0.03 s threw spray far higher (docs/models.md)
 constexpr float kMaxHyperviscosityStep = 0.4f;
 inline float hyperviscosityStep(float rate, float h) { return std::min(rate * h, kMaxHyperviscosityStep); }
 

@@ -28,6 +28,13 @@ struct StageClock {
     stage += t;
     ms.part(part) += t;
   }
+  // a lap of which `inner` ms (timed by the stage itself) belong to part b, the rest to part a
+  void lap(double& stage, StagePart a, StagePart b, double inner) {
+    const double t = clock.lap();
+    stage += t;
+    ms.part(a) += t - inner;
+    ms.part(b) += inner;
+  }
 };
 
 // x* of every particle: new water, gravity, the colliders' poses at the substep's end, and the
@@ -61,10 +68,8 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
   stats.fluidIterations += static_cast<uint64_t>(its);
   stats.fluidIterationsMax = std::max(stats.fluidIterationsMax, its);
   clock.lap(ms.water);
-  stepCloth(model, p, ws.cloth, h);                                                 // small steps: tethers, Eq. 8, Eq. 9
-  clock.lap(ms.cloth, StagePart::clothSolve);
-  clothSelfCollision(model, p, ws.neighbors, ws.cloth);
-  clock.lap(ms.cloth, StagePart::clothSelfCollision);
+  stepCloth(model, p, ws.neighbors, ws.cloth, h);                                   // small steps: tethers, Eq. 8, Eq. 9, self-collision
+  clock.lap(ms.cloth, StagePart::clothSolve, StagePart::clothSelfCollision, ws.cloth.selfCollisionMs);
   stats.colliderPutBack += projectColliders(model, ws.poses, p, ws.pbdParticles, h, ws.contactNormal,
                                             ws.colliderBound);                       // Coulomb friction
   clock.lap(ms.colliders);

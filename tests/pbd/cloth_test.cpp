@@ -312,15 +312,16 @@ float closestCollidingPair(const Model& m, const Particles& p, int first, int co
   return closest;
 }
 
-TEST(ClothSelfCollision, FoldedSheetLayersEndAThicknessApart) {
-  // a 21 x 21 sheet folded onto itself along row 10: row 10 + k lies 3 mm above row 10 - k
-  const int res = 21;
+// a 21 x 21 sheet (thickness 1 cm, particle 9 x 21 held) folded onto itself along row 10: row 10 + k
+// lies 3 mm above row 10 - k; and a second piece 4 mm under a corner of the lower layer (other pieces
+// are not self-collision's business). Returns the particles; the model gets both pieces.
+constexpr int kFoldRes = 21;
+Particles foldedSheet(Model& model) {
+  const int res = kFoldRes;
   ClothMaterial mat;
   mat.thickness = 0.01f;
-  Model model;
   addClothPiece(model, "sheet", makeRectangle(Vec3(0, 1, 0), Vec3::UnitX(), Vec3::UnitZ(), 0.5f, 0.5f, res, res), mat,
                 {9 * res}, "test");
-  // a second piece 4 mm under a corner of the lower layer: other pieces are not self-collision's business
   addClothPiece(model, "other",
                 makeRectangle(Vec3(-0.225f, 0.996f, -0.225f), Vec3::UnitX(), Vec3::UnitZ(), 0.05f, 0.05f, 3, 3), mat,
                 {}, "test");
@@ -333,6 +334,15 @@ TEST(ClothSelfCollision, FoldedSheetLayersEndAThicknessApart) {
     p.add(i < n1 ? 1 : 2, static_cast<uint32_t>(i), model.clothDryMass[i], 0.04f, x, Vec3::Zero());
     if (model.clothPinned[i]) p.invMass[i] = 0.0f;
   }
+  return p;
+}
+
+TEST(ClothSelfCollision, FoldedSheetLayersEndAThicknessApart) {
+  const int res = kFoldRes;
+  Model model;
+  Particles p = foldedSheet(model);
+  const ClothMaterial& mat = model.pieces[0].material;
+  const int n = model.numCloth, n1 = res * res;
   const std::vector<Vec3> start = p.xPred;
   EXPECT_NEAR(closestCollidingPair(model, p, 0, n1), 0.003f, 1e-6f);
   const NeighborLists nl = bruteNeighbors(p.xPred, 0.04f);
@@ -344,9 +354,7 @@ TEST(ClothSelfCollision, FoldedSheetLayersEndAThicknessApart) {
   EXPECT_EQ(p.xPred, start);
   model.pieces[0].material.selfCollision = true;
 
-  clothSelfCollision(model, p, nl, scratch);
-  int contacts = 0;
-  for (int i = 0; i < n1; ++i) contacts += scratch.deltaCount[i];
+  const int contacts = clothSelfCollision(model, p, nl, scratch);
   EXPECT_EQ(contacts, 2 * 10 * res - 1);  // each folded pair seen from both sides, but not from the pinned one
   for (int pass = 0; pass < 2; ++pass) clothSelfCollision(model, p, nl, scratch);
 
@@ -389,13 +397,53 @@ TEST(ClothSelfCollision, LeavesMeshNeighboursAndPairsCloseAtRestAlone) {
   q.xPred[13] = q.xPred[12] + Vec3(0.001f, 0, 0);
   q.xPred[24] = q.xPred[0] + Vec3(0, 0, 0.004f);
   start = q.xPred;
-  clothSelfCollision(coarse, q, bruteNeighbors(q.xPred, 0.04f), scratch);
+  EXPECT_EQ(clothSelfCollision(coarse, q, bruteNeighbors(q.xPred, 0.04f), scratch), 2);  // 0 and 24, not 12 and 13
   EXPECT_EQ(q.xPred[12], start[12]);
   EXPECT_EQ(q.xPred[13], start[13]);
   EXPECT_NEAR((q.xPred[24] - q.xPred[0]).norm(), 0.01f, 1e-6f);
   EXPECT_NEAR(q.xPred[24].z(), 0.007f, 1e-6f);
-  EXPECT_EQ(scratch.deltaCount[0], 1);
-  EXPECT_EQ(scratch.deltaCount[13], 0);
+}
+
+TEST(ClothSelfCollision, TheSmallStepsPushTheNearPairsAsTheFullPassDoes) {
+  // the pairs found within two thicknesses at a substep's start (findSelfCollisionPairs) and pushed in
+  // each small step (collideSelfCollisionPairs) give what the pass over every neighbour gives
+  const int res = kFoldRes;
+  Model model;
+  Particles p = foldedSheet(model);
+  const float d = model.pieces[0].material.thickness;
+  const int n1 = res * res;
+  const NeighborLists nl = bruteNeighbors(p.xPred, 0.04f);
+  p.xPred[13 * res + 7].y() += 0.012f;  // 15 mm over its mirror: a candidate, not pushed
+  ClothScratch scratch;
+  findSelfCollisionPairs(model, p, nl, scratch);
+  // every pair of the sheet (not 1-ring, apart by more than d at rest, one end free) within 2 d, each side
+  int expected = 0;
+  for (int i = 0; i < n1; ++i)
+    for (int j = 0; j < n1; ++j)
+      if (i != j && p.invMass[i] > 0.0f && !ringNeighbors(model, i, j) && (p.xPred[i] - p.xPred[j]).norm() < 2.0f * d &&
+          (model.clothRestPosition[i] - model.clothRestPosition[j]).norm() > d)
+        ++expected;
+  EXPECT_EQ(scratch.pairCount[model.numCloth], expected);
+  EXPECT_EQ(expected, 2 * 10 * res - 1);  // each particle over its mirror, both sides, but not from the held one
+  Particles full = p;
+  ClothScratch fullScratch;
+  const int pushed = collideSelfCollisionPairs(model, p, scratch);
+  EXPECT_EQ(pushed, clothSelfCollision(model, full, nl, fullScratch));
+  EXPECT_EQ(pushed, 2 * 10 * res - 3);  // the lifted one's pair is no longer within d
+  EXPECT_EQ(p.xPred, full.xPred);
+
+  // in a substep of 4 small steps without gravity the fold opens to the thickness within the substep
+  Model stepped;
+  Particles q = foldedSheet(stepped);
+  stepped.solver.gravity = Vec3::Zero();
+  stepped.solver.clothSubsteps = 4;
+  stepped.solver.clothIterations = 1;
+  buildClothConstraints(stepped);
+  const NeighborLists ql = bruteNeighbors(q.xPred, 0.04f);
+  ClothScratch qs;
+  stepCloth(stepped, q, ql, qs, 0.0075f);
+  EXPECT_GT(closestCollidingPair(stepped, q, 0, n1), 0.95f * d);
+  EXPECT_GE(qs.selfCollisionMs, 0.0);
 }
 
 }  // namespace

@@ -1,0 +1,134 @@
+// particle-particle self-collision of the PBD cloth (Müller et al. 2007, thickness d): after each small
+// step over the pairs found near at the substep's start, and once after the small steps over all
+// neighbours (docs/models.md, "Cloth self-collision in the small steps")
+#include "core/parallel.hpp"
+#include "pbd/cloth.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace soak {
+
+namespace {
+
+// candidate pairs reach this many thicknesses at the substep's start
+constexpr float kCandidateReach = 2.0f;
+
+// what a pair (i, j) of one piece may push: d of i's piece where the piece is PBD with self-collision
+// and i moves, 0 otherwise
+float selfCollisionThickness(const Model& model, const Particles& p, int i) {
+  const int piece = clothPiece(p.phase[i]);
+  if (piece < 0 || piece >= static_cast<int>(model.pieces.size())) return 0.0f;
+  const ClothMaterial& mat = model.pieces[piece].material;
+  // an implicit piece has its own (garment/self_collision.hpp)
+  if (!mat.selfCollision || p.invMass[i] == 0.0f || model.pieces[piece].solver != ClothSolver::Pbd) return 0.0f;
+  return mat.thickness;
+}
+
+// whether j, closer to i than `reach`, is a pair of i's: not i's 1-ring neighbour, of the same piece,
+// not both held, and apart by more than d at rest (pairs this close at rest belong together: fine
+// meshes, seams; Eq. 8 keeps them). The distance comes first: nearly every neighbour is farther.
+bool isPair(const Model& model, const Particles& p, int i, int j, float d, float reach, float& dist2) {
+  dist2 = (p.xPred[i] - p.xPred[j]).squaredNorm();
+  if (dist2 >= reach * reach || dist2 < 1e-24f) return false;
+  const auto ring = model.vertexNeighbors.begin();
+  if (std::binary_search(ring + model.vertexNeighborStart[i], ring + model.vertexNeighborStart[i + 1], j)) return false;
+  if (j == i || p.phase[j] != p.phase[i] || p.invMass[i] + p.invMass[j] == 0.0f) return false;
+  return (model.clothRestPosition[i] - model.clothRestPosition[j]).squaredNorm() > d * d;
+}
+
+// i's move away from j at distance dist < d: w_i/(w_i + w_j) (d - dist) x_ij/dist
+Vec3 pushApart(const Particles& p, int i, int j, float d, float dist) {
+  const float wi = p.invMass[i], wj = p.invMass[j];
+  return (wi / (wi + wj) * (d - dist) / dist) * Vec3(p.xPred[i] - p.xPred[j]);
+}
+
+// adds each particle's gathered move (Jacobi: the result does not depend on the thread count); returns
+// the pairs pushed, each seen from both sides
+int applyMoves(Particles& p, ClothScratch& scratch, int n) {
+  Vec3* x = p.xPred.data();
+  const Vec3* delta = scratch.delta.data();
+  parallelFor(n, [&](int64_t i) { x[i] += delta[i]; });
+  int contacts = 0;
+  for (int i = 0; i < n; ++i) contacts += scratch.contacts[i];
+  return contacts;
+}
+
+}  // namespace
+
+int clothSelfCollision(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch) {
+  const int n = model.numCloth;
+  scratch.delta.assign(n, Vec3::Zero());
+  scratch.contacts.assign(n, 0);
+  if (n == 0) return 0;
+  parallelForDynamic(n, kClothChunk, [&](int64_t ii) {  // folds have more neighbours
+    const int i = static_cast<int>(ii);
+    const float d = selfCollisionThickness(model, p, i);
+    if (d <= 0.0f) return;
+    Vec3 sum = Vec3::Zero();
+    for (uint32_t s = neighbors.start[i], end = neighbors.clothEnd(i, static_cast<uint32_t>(n)); s < end; ++s) {
+      const int j = static_cast<int>(neighbors.index[s]);
+      float dist2 = 0.0f;
+      if (j < n && isPair(model, p, i, j, d, d, dist2)) {
+        sum += pushApart(p, i, j, d, std::sqrt(dist2));
+        ++scratch.contacts[i];
+      }
+    }
+    scratch.delta[i] = sum;
+  });
+  return applyMoves(p, scratch, n);
+}
+
+void findSelfCollisionPairs(const Model& model, const Particles& p, const NeighborLists& neighbors,
+                            ClothScratch& scratch) {
+  const int n = model.numCloth;
+  scratch.pairCount.assign(static_cast<size_t>(n) + 1, 0);
+  scratch.pairs.clear();
+  if (n == 0) return;
+  // count, then fill: each particle's pairs in its neighbour list's order
+  const auto visit = [&](int i, auto&& put) {
+    const float d = selfCollisionThickness(model, p, i);
+    if (d <= 0.0f) return;
+    for (uint32_t s = neighbors.start[i], end = neighbors.clothEnd(i, static_cast<uint32_t>(n)); s < end; ++s) {
+      const int j = static_cast<int>(neighbors.index[s]);
+      float dist2 = 0.0f;
+      if (j < n && isPair(model, p, i, j, d, kCandidateReach * d, dist2)) put(j);
+    }
+  };
+  parallelForDynamic(n, kClothChunk, [&](int64_t i) {
+    int count = 0;
+    visit(static_cast<int>(i), [&](int) { ++count; });
+    scratch.pairCount[i + 1] = count;
+  });
+  for (int i = 0; i < n; ++i) scratch.pairCount[i + 1] += scratch.pairCount[i];
+  scratch.pairs.resize(static_cast<size_t>(scratch.pairCount[n]));
+  parallelForDynamic(n, kClothChunk, [&](int64_t i) {
+    int k = scratch.pairCount[i];
+    visit(static_cast<int>(i), [&](int j) { scratch.pairs[k++] = j; });
+  });
+}
+
+int collideSelfCollisionPairs(const Model& model, Particles& p, ClothScratch& scratch) {
+  const int n = model.numCloth;
+  if (scratch.pairs.empty()) return 0;
+  scratch.delta.assign(n, Vec3::Zero());
+  scratch.contacts.assign(n, 0);
+  parallelForDynamic(n, kClothChunk, [&](int64_t ii) {
+    const int i = static_cast<int>(ii);
+    if (scratch.pairCount[i] == scratch.pairCount[i + 1]) return;
+    const float d = selfCollisionThickness(model, p, i);
+    Vec3 sum = Vec3::Zero();
+    for (int k = scratch.pairCount[i]; k < scratch.pairCount[i + 1]; ++k) {
+      const int j = scratch.pairs[k];
+      const float dist2 = (p.xPred[i] - p.xPred[j]).squaredNorm();
+      if (dist2 < d * d && dist2 >= 1e-24f) {
+        sum += pushApart(p, i, j, d, std::sqrt(dist2));
+        ++scratch.contacts[i];
+      }
+    }
+    scratch.delta[i] = sum;
+  });
+  return applyMoves(p, scratch, n);
+}
+
+}  // namespace soak
