@@ -1,6 +1,6 @@
-// particle-particle self-collision of the PBD cloth (Müller et al. 2007, thickness d): after each small
-// step over the pairs found near at the substep's start, and once after the small steps over all
-// neighbours (docs/models.md, "Cloth self-collision in the small steps")
+// particle-particle self-collision of the PBD cloth (Müller et al. 2007, thickness d): with small steps,
+// after each of them over the pairs found near at the substep's start; with one step, once after it
+// over all neighbours (docs/models.md, "Cloth self-collision in the small steps")
 #include "core/parallel.hpp"
 #include "pbd/cloth.hpp"
 
