@@ -24,6 +24,7 @@ struct ClothScratch {
   std::vector<int> contacts;          // the pairs that pass pushed each particle away from
   double selfCollisionMs = 0.0;       // the last stepCloth's time in the self-collision (stage timings)
   std::vector<int> pairCount, pairs;  // CSR: particle i's self-collision pairs are pairs[pairCount[i], pairCount[i + 1])
+  std::vector<float> speed;           // m/s, |v| of each cloth particle at the substep's start (findSelfCollisionPairs)
   std::vector<Vec3> stepPosition, stepVelocity;  // m, m/s: a cloth particle's at the start of a small step
   std::vector<Vec3> velocityOffset;  // m/s: the last small step's velocity minus (x* - x)/h (stepCloth)
 };
@@ -52,9 +53,10 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
 // returns the pairs pushed, each counted from both sides (once where one end is held)
 int clothSelfCollision(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch);
 
-// the pairs clothSelfCollision would consider that are within two thicknesses of each other now,
-// into scratch.pairCount / scratch.pairs (the small steps' candidates)
-void findSelfCollisionPairs(const Model& model, const Particles& p, const NeighborLists& neighbors,
+// the pairs clothSelfCollision would consider that may come within its thickness d in the substep of h
+// that starts (closer than 1.25 d plus |v_i - v_j| h at x*), into scratch.pairCount / scratch.pairs
+// (the small steps' candidates)
+void findSelfCollisionPairs(const Model& model, const Particles& p, const NeighborLists& neighbors, float h,
                             ClothScratch& scratch);
 
 // clothSelfCollision's push over the pairs findSelfCollisionPairs found only; returns as it does

@@ -29,7 +29,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
   // crumpled fold's layers were pulled back by the small steps' constraints at 1/h_s and jittered at
   // metres a second (docs/models.md, "Cloth self-collision in the small steps")
   clock.lap();
-  findSelfCollisionPairs(model, p, neighbors, scratch);
+  findSelfCollisionPairs(model, p, neighbors, h, scratch);
   scratch.selfCollisionMs += clock.lap();
   const float hs = h / static_cast<float>(steps);
   const Vec3 g = model.solver.gravity;

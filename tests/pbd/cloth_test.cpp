@@ -405,31 +405,40 @@ TEST(ClothSelfCollision, LeavesMeshNeighboursAndPairsCloseAtRestAlone) {
 }
 
 TEST(ClothSelfCollision, TheSmallStepsPushTheNearPairsAsTheFullPassDoes) {
-  // the pairs found within two thicknesses at a substep's start (findSelfCollisionPairs) and pushed in
-  // each small step (collideSelfCollisionPairs) give what the pass over every neighbour gives
+  // the pairs found within 1.25 thicknesses (still particles) at a substep's start
+  // (findSelfCollisionPairs) and pushed in each small step (collideSelfCollisionPairs) give what the
+  // pass over every neighbour gives
   const int res = kFoldRes;
   Model model;
   Particles p = foldedSheet(model);
   const float d = model.pieces[0].material.thickness;
   const int n1 = res * res;
   const NeighborLists nl = bruteNeighbors(p.xPred, 0.04f);
-  p.xPred[13 * res + 7].y() += 0.012f;  // 15 mm over its mirror: a candidate, not pushed
+  p.xPred[13 * res + 7].y() += 0.008f;  // 11 mm over its mirror: a candidate, not pushed
+  p.xPred[14 * res + 7].y() += 0.012f;  // 15 mm: not even a candidate while the two stand still
   ClothScratch scratch;
-  findSelfCollisionPairs(model, p, nl, scratch);
-  // every pair of the sheet (not 1-ring, apart by more than d at rest, one end free) within 2 d, each side
+  findSelfCollisionPairs(model, p, nl, 0.0075f, scratch);
+  // every pair of the sheet (not 1-ring, apart by more than d at rest, one end free) within 1.25 d, each side
   int expected = 0;
   for (int i = 0; i < n1; ++i)
     for (int j = 0; j < n1; ++j)
-      if (i != j && p.invMass[i] > 0.0f && !ringNeighbors(model, i, j) && (p.xPred[i] - p.xPred[j]).norm() < 2.0f * d &&
+      if (i != j && p.invMass[i] > 0.0f && !ringNeighbors(model, i, j) && (p.xPred[i] - p.xPred[j]).norm() < 1.25f * d &&
           (model.clothRestPosition[i] - model.clothRestPosition[j]).norm() > d)
         ++expected;
   EXPECT_EQ(scratch.pairCount[model.numCloth], expected);
-  EXPECT_EQ(expected, 2 * 10 * res - 1);  // each particle over its mirror, both sides, but not from the held one
+  EXPECT_EQ(expected, 2 * 10 * res - 3);  // each particle over its mirror, both sides, not from the held one, not the 15 mm pair
+  // one of them moving at 1 m/s against the other (either way: the reach takes the relative speed, not
+  // its direction): a candidate
+  p.v[14 * res + 7] = Vec3(0, 1, 0);
+  ClothScratch moving;
+  findSelfCollisionPairs(model, p, nl, 0.0075f, moving);
+  EXPECT_EQ(moving.pairCount[model.numCloth], expected + 2);
+  p.v[14 * res + 7] = Vec3::Zero();
   Particles full = p;
   ClothScratch fullScratch;
   const int pushed = collideSelfCollisionPairs(model, p, scratch);
   EXPECT_EQ(pushed, clothSelfCollision(model, full, nl, fullScratch));
-  EXPECT_EQ(pushed, 2 * 10 * res - 3);  // the lifted one's pair is no longer within d
+  EXPECT_EQ(pushed, 2 * 10 * res - 5);  // the lifted ones' pairs are no longer within d
   EXPECT_EQ(p.xPred, full.xPred);
 
   // in a substep of 4 small steps without gravity the fold opens to the thickness within the substep
