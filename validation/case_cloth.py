@@ -88,7 +88,9 @@ def measure(out):
         s99.append(float(np.percentile(strain, 99)))
         energy.append(float(np.mean(0.5 * vel2[free] + G * x[free, 1])))  # equal masses: per kg
         ends = free[edges[:, 0]].astype(float) + free[edges[:, 1]]  # m (1/m_a + 1/m_b), per unit mass m
-        stretch.append(float(np.sum(0.5 * (strain * rest) ** 2 / (ends * hs * hs)) / np.count_nonzero(free)))
+        held = ends > 0  # an edge between two pins holds nothing
+        stretch.append(float(np.sum(0.5 * (strain[held] * rest[held]) ** 2 / (ends[held] * hs * hs)))
+                       / np.count_nonzero(free))
     return {"t": np.array(t), "max": np.array(smax), "p99": np.array(s99), "energy": np.array(energy),
             "stretch": np.array(stretch), "x": x, "x0": x0}
 

@@ -20,10 +20,11 @@ struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
   std::vector<float> correction;      // m, the moves of the stretch constraints' particles, 6 per constraint (SoA)
   std::vector<float> correctionBend;  // m, the same for the bend constraints, 12 per constraint
-  std::vector<Vec3> delta;            // m, each particle's self-collision move of a pass
-  std::vector<int> contacts;          // the pairs that pass pushed each particle away from
+  std::vector<Vec3> delta;            // m, the self-collision moves of a pass (per particle, or per pair owner)
+  std::vector<int> contacts;          // the pairs that pass pushed each of them away from
   double selfCollisionMs = 0.0;       // the last stepCloth's time in the self-collision (stage timings)
   std::vector<int> pairCount, pairs;  // CSR: particle i's self-collision pairs are pairs[pairCount[i], pairCount[i + 1])
+  std::vector<int> pairOwners;        // the particles with at least one such pair, in order
   std::vector<float> speed;           // m/s, |v| of each cloth particle at the substep's start (findSelfCollisionPairs)
   std::vector<Vec3> stepPosition, stepVelocity;  // m, m/s: a cloth particle's at the start of a small step
   std::vector<Vec3> velocityOffset;  // m/s: the last small step's velocity minus (x* - x)/h (stepCloth)

@@ -45,14 +45,14 @@ Vec3 pushApart(const Particles& p, int i, int j, float d, float dist) {
   return (wi / (wi + wj) * (d - dist) / dist) * Vec3(p.xPred[i] - p.xPred[j]);
 }
 
-// adds each particle's gathered move (Jacobi: the result does not depend on the thread count); returns
-// the pairs pushed, each seen from both sides
-int applyMoves(Particles& p, ClothScratch& scratch, int n) {
+// adds the gathered moves delta[r] to particle owner[r] (owner null: particle r), r < count (Jacobi: the
+// result does not depend on the thread count); returns the pairs pushed, each seen from both sides
+int applyMoves(Particles& p, ClothScratch& scratch, int count, const int* owner) {
   Vec3* x = p.xPred.data();
   const Vec3* delta = scratch.delta.data();
-  parallelFor(n, [&](int64_t i) { x[i] += delta[i]; });
+  parallelFor(count, [&](int64_t r) { x[owner ? owner[r] : r] += delta[r]; });
   int contacts = 0;
-  for (int i = 0; i < n; ++i) contacts += scratch.contacts[i];
+  for (int r = 0; r < count; ++r) contacts += scratch.contacts[r];
   return contacts;
 }
 
@@ -78,7 +78,7 @@ int clothSelfCollision(const Model& model, Particles& p, const NeighborLists& ne
     }
     scratch.delta[i] = sum;
   });
-  return applyMoves(p, scratch, n);
+  return applyMoves(p, scratch, n, nullptr);
 }
 
 void findSelfCollisionPairs(const Model& model, const Particles& p, const NeighborLists& neighbors, float h,
@@ -86,6 +86,7 @@ void findSelfCollisionPairs(const Model& model, const Particles& p, const Neighb
   const int n = model.numCloth;
   scratch.pairCount.assign(static_cast<size_t>(n) + 1, 0);
   scratch.pairs.clear();
+  scratch.pairOwners.clear();
   if (n == 0) return;
   scratch.speed.resize(static_cast<size_t>(n));
   parallelFor(n, [&](int64_t i) { scratch.speed[i] = p.v[i].norm(); });
@@ -115,19 +116,20 @@ void findSelfCollisionPairs(const Model& model, const Particles& p, const Neighb
   for (int i = 0; i < n; ++i) {  // packing moves entries towards the front only: serial, in order
     const int from = static_cast<int>(neighbors.start[i]), count = scratch.pairCount[i + 1];
     scratch.pairCount[i + 1] = scratch.pairCount[i] + count;
+    if (count > 0) scratch.pairOwners.push_back(i);
     std::copy(scratch.pairs.begin() + from, scratch.pairs.begin() + from + count, scratch.pairs.begin() + scratch.pairCount[i]);
   }
   scratch.pairs.resize(static_cast<size_t>(scratch.pairCount[n]));
 }
 
 int collideSelfCollisionPairs(const Model& model, Particles& p, ClothScratch& scratch) {
-  const int n = model.numCloth;
-  if (scratch.pairs.empty()) return 0;
-  scratch.delta.assign(n, Vec3::Zero());
-  scratch.contacts.assign(n, 0);
-  parallelForDynamic(n, kClothChunk, [&](int64_t ii) {
-    const int i = static_cast<int>(ii);
-    if (scratch.pairCount[i] == scratch.pairCount[i + 1]) return;
+  // only the particles with pairs: in each small step, a flat sheet has none
+  const int owners = static_cast<int>(scratch.pairOwners.size());
+  if (owners == 0) return 0;
+  scratch.delta.resize(static_cast<size_t>(owners));
+  scratch.contacts.assign(static_cast<size_t>(owners), 0);
+  parallelForDynamic(owners, kClothChunk, [&](int64_t r) {
+    const int i = scratch.pairOwners[r];
     const float d = selfCollisionThickness(model, p, i);
     Vec3 sum = Vec3::Zero();
     for (int k = scratch.pairCount[i]; k < scratch.pairCount[i + 1]; ++k) {
@@ -135,12 +137,12 @@ int collideSelfCollisionPairs(const Model& model, Particles& p, ClothScratch& sc
       const float dist2 = (p.xPred[i] - p.xPred[j]).squaredNorm();
       if (dist2 < d * d && dist2 >= 1e-24f) {
         sum += pushApart(p, i, j, d, std::sqrt(dist2));
-        ++scratch.contacts[i];
+        ++scratch.contacts[r];
       }
     }
-    scratch.delta[i] = sum;
+    scratch.delta[r] = sum;
   });
-  return applyMoves(p, scratch, n);
+  return applyMoves(p, scratch, owners, scratch.pairOwners.data());
 }
 
 }  // namespace soak

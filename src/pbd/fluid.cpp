@@ -307,6 +307,12 @@ struct VelocityPass {
   bool keepSum;  // the hyperviscosity follows: each particle's XSPH sum (L v) to s.velocitySum
 };
 
+// V_ij = m_j over the pair's mean density, the weight of the XSPH and hyperviscosity sums: m_i V_ij is
+// symmetric, so sum_i m_i dv_i = 0 (momentum conserved); 0 for a cloth neighbour
+inline float pairVolume(const VelocityPass& c, uint32_t j, float di) {
+  return c.p.phase[j] == kWaterPhase ? 2.0f * c.p.mass[j] / std::max(di + c.s.density[j], 1e-3f) : 0.0f;
+}
+
 // one water particle's XSPH velocity (Macklin 2013 Eq. 17, weighted by V_ij) to s.delta and, with
 // Vort, its vorticity omega_i = sum_j V_j v_ij x grad W_ij (Eq. 15) to s.vorticity
 template <bool U, bool Vort>
@@ -324,8 +330,7 @@ void xsphOf(const VelocityPass& c, size_t i) {
     const float r2 = rx * rx + ry * ry + rz * rz;
     const float h = pairRadius(hi, H[j]);
     const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(h, 1.0f / h);
-    // m_j over the pair's mean density keeps sum m_i dv_i = 0 (momentum conserved)
-    const float vol = c.p.phase[j] == kWaterPhase ? 2.0f * c.p.mass[j] / std::max(di + D[j], 1e-3f) : 0.0f;
+    const float vol = pairVolume(c, j, di);
     const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
     const float wgt = vol * pbf::poly6Value(kernel, r2);
     bx += wgt * vx;
@@ -360,7 +365,7 @@ void hyperviscosityOf(const VelocityPass& c, size_t i, float k) {
     const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
     const float h = U ? 0.0f : pairRadius(hi, H[j]);
     const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(h, 1.0f / h);
-    const float vol = 2.0f * c.p.mass[j] / std::max(di + D[j], 1e-3f);
+    const float vol = pairVolume(c, j, di);
     sum += (vol * pbf::poly6Value(kernel, rx * rx + ry * ry + rz * rz)) * (B[j] - B[i]);
   }
   c.s.delta[i] -= k * sum;

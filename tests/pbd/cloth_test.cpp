@@ -452,7 +452,6 @@ TEST(ClothSelfCollision, TheSmallStepsPushTheNearPairsAsTheFullPassDoes) {
   ClothScratch qs;
   stepCloth(stepped, q, ql, qs, 0.0075f);
   EXPECT_GT(closestCollidingPair(stepped, q, 0, n1), 0.95f * d);
-  EXPECT_GE(qs.selfCollisionMs, 0.0);
 }
 
 }  // namespace
