@@ -313,24 +313,33 @@ inline float pairVolume(const VelocityPass& c, uint32_t j, float di) {
   return c.p.phase[j] == kWaterPhase ? 2.0f * c.p.mass[j] / std::max(di + c.s.density[j], 1e-3f) : 0.0f;
 }
 
+// calls f(j, rx, ry, rz, r2, kernel, V_ij) for each water neighbour j of water particle i, x_ij =
+// (rx, ry, rz): the one neighbour walk of the XSPH and hyperviscosity sums (U: every radius equal,
+// the kernel is c.kU). Cloth neighbours (V_ij = 0) are skipped.
+template <bool U, class F>
+inline void forWaterPairs(const VelocityPass& c, size_t i, F&& f) {
+  const float* X = c.p.xPred[0].data();
+  const float* H = c.p.radius.data();
+  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = c.s.density[i];
+  for (uint32_t k = c.nb.waterBegin(i, static_cast<uint32_t>(c.nc)); k < c.nb.start[i + 1]; ++k) {
+    const uint32_t j = c.nb.index[k];
+    if (c.p.phase[j] != kWaterPhase) continue;
+    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
+    const float h = U ? 0.0f : pairRadius(hi, H[j]);
+    const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(h, 1.0f / h);
+    f(j, rx, ry, rz, rx * rx + ry * ry + rz * rz, kernel, pairVolume(c, j, di));
+  }
+}
+
 // one water particle's XSPH velocity (Macklin 2013 Eq. 17, weighted by V_ij) to s.delta and, with
 // Vort, its vorticity omega_i = sum_j V_j v_ij x grad W_ij (Eq. 15) to s.vorticity
 template <bool U, bool Vort>
 void xsphOf(const VelocityPass& c, size_t i) {
-  const float* X = c.p.xPred[0].data();
   const float* V = c.p.v[0].data();
-  const float* H = c.p.radius.data();
-  const float* D = c.s.density.data();
-  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
   const float vxi = V[3 * i], vyi = V[3 * i + 1], vzi = V[3 * i + 2];
   float bx = 0.0f, by = 0.0f, bz = 0.0f, ox = 0.0f, oy = 0.0f, oz = 0.0f;
-  for (uint32_t k = c.nb.waterBegin(i, static_cast<uint32_t>(c.nc)); k < c.nb.start[i + 1]; ++k) {
-    const uint32_t j = c.nb.index[k];
-    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-    const float r2 = rx * rx + ry * ry + rz * rz;
-    const float h = pairRadius(hi, H[j]);
-    const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(h, 1.0f / h);
-    const float vol = pairVolume(c, j, di);
+  forWaterPairs<U>(c, i, [&](uint32_t j, float rx, float ry, float rz, float r2, const pbf::PairKernel<float>& kernel,
+                             float vol) {
     const float vx = V[3 * j] - vxi, vy = V[3 * j + 1] - vyi, vz = V[3 * j + 2] - vzi;
     const float wgt = vol * pbf::poly6Value(kernel, r2);
     bx += wgt * vx;
@@ -342,7 +351,7 @@ void xsphOf(const VelocityPass& c, size_t i) {
       oy += f * (vz * rx - vx * rz);
       oz += f * (vx * ry - vy * rx);
     }
-  }
+  });
   if (Vort) c.s.vorticity[i] = Vec3(ox, oy, oz);
   if (c.keepSum) c.s.velocitySum[i] = Vec3(bx, by, bz);
   c.s.delta[i] = Vec3(vxi, vyi, vzi) + c.viscosity * Vec3(bx, by, bz);
@@ -353,21 +362,10 @@ void xsphOf(const VelocityPass& c, size_t i) {
 // sum_i m_i dv_i = 0 and a velocity field linear in position (L v = 0 where the support is full) is kept
 template <bool U>
 void hyperviscosityOf(const VelocityPass& c, size_t i, float k) {
-  const float* X = c.p.xPred[0].data();
-  const float* H = c.p.radius.data();
-  const float* D = c.s.density.data();
   const Vec3* B = c.s.velocitySum.data();
-  const float xi = X[3 * i], yi = X[3 * i + 1], zi = X[3 * i + 2], hi = H[i], di = D[i];
   Vec3 sum = Vec3::Zero();
-  for (uint32_t n = c.nb.waterBegin(i, static_cast<uint32_t>(c.nc)); n < c.nb.start[i + 1]; ++n) {
-    const uint32_t j = c.nb.index[n];
-    if (c.p.phase[j] != kWaterPhase) continue;
-    const float rx = xi - X[3 * j], ry = yi - X[3 * j + 1], rz = zi - X[3 * j + 2];
-    const float h = U ? 0.0f : pairRadius(hi, H[j]);
-    const pbf::PairKernel<float> kernel = U ? c.kU : pbf::pairKernel(h, 1.0f / h);
-    const float vol = pairVolume(c, j, di);
-    sum += (vol * pbf::poly6Value(kernel, rx * rx + ry * ry + rz * rz)) * (B[j] - B[i]);
-  }
+  forWaterPairs<U>(c, i, [&](uint32_t j, float, float, float, float r2, const pbf::PairKernel<float>& kernel,
+                             float vol) { sum += (vol * pbf::poly6Value(kernel, r2)) * (B[j] - B[i]); });
   c.s.delta[i] -= k * sum;
 }
 
