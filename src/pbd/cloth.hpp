@@ -4,8 +4,11 @@
 #include <soak/model.hpp>
 #include <soak/state.hpp>
 
+#include "core/parallel.hpp"
 #include "grid/grid.hpp"
+#include "world/colliders.hpp"
 
+#include <cstdint>
 #include <vector>
 
 namespace soak {
@@ -28,6 +31,17 @@ struct ClothScratch {
   std::vector<float> speed;           // m/s, |v| of each cloth particle at the substep's start (findSelfCollisionPairs)
   std::vector<Vec3> stepPosition, stepVelocity;  // m, m/s: a cloth particle's at the start of a small step
   std::vector<Vec3> velocityOffset;  // m/s: the last small step's velocity minus (x* - x)/h (stepCloth)
+  std::vector<Vec3> stepStart;       // m, x* before a small step's prediction: where its collider contact starts
+  std::vector<float> colliderBound;  // m, a lower bound of each cloth particle's distance to the colliders
+  std::vector<int> colliderCandidates;  // the cloth particles that may meet a collider in the substep
+  uint64_t colliderPutBack = 0;      // the small steps' collider put-backs of the last stepCloth
+};
+
+// the colliders the PBD cloth meets in each of its small steps (step.cpp fills it; smallStepPoses)
+struct SmallStepColliders {
+  std::vector<std::vector<ColliderPose>> poses;  // the colliders' poses at the end of each small step
+  std::vector<uint8_t> include;                  // the colliders that take part: all but a moving mesh sequence
+  std::vector<IndexRange> cloth;                 // the PBD cloth's particles
 };
 
 // C(x1, x2) = |x1 - x2| - l0 (Eq. 8); returns C and writes gradients wrt x1 and x2
@@ -43,10 +57,12 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
 
 // the PBD cloth's substep of h: model.solver.clothSubsteps small steps of h/clothSubsteps, each a
 // prediction from the last (v += h_s g, x* = x + h_s v), the tethers, clothIterations iterations
-// of solveCloth and the self-collision of the pairs near at the substep's start (Macklin et al. 2019:
+// of solveCloth, the self-collision of the pairs near at the substep's start and, with colliders, the
+// contact and Coulomb friction of the colliders at the small step's end (Macklin et al. 2019:
 // substeps converge faster than iterations). Leaves x* at the last small step's end and
 // scratch.velocityOffset for updateVelocities. Moves only free PBD cloth. neighbors: the lists of x*.
-void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h);
+void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h,
+               const SmallStepColliders* colliders = nullptr);
 
 // pushes apart cloth particles of the same piece closer than its thickness d that are not mesh
 // neighbours nor closer than d at rest: delta_i = sum_j w_i/(w_i + w_j) (d - |x_ij|) x_ij/|x_ij|

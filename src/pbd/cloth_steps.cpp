@@ -7,10 +7,43 @@
 #include "pbd/cloth.hpp"
 #include "pbd/tethers.hpp"
 
+#include <limits>
+
 namespace soak {
 
-void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h) {
+namespace {
+
+// the free PBD cloth particles that may meet a collider in the substep of h: a lower bound of their
+// distance at its start (to the colliders at its end) within twice their margin plus how far they may
+// travel, (|v| + |g| h) h, and how far a moving collider may come, its speed bound times h. A particle
+// that goes farther (pulled by its constraints) meets the colliders once, after the small steps
+void findColliderCandidates(const Model& model, const SmallStepColliders& colliders, const Particles& p, float h,
+                            ClothScratch& scratch) {
   const int n = model.numCloth;
+  const std::vector<ColliderPose>& poses = colliders.poses.back();
+  scratch.colliderBound.assign(static_cast<size_t>(n), std::numeric_limits<float>::max());
+  for (size_t c = 0; c < model.colliders.size() && c < poses.size(); ++c)
+    if (colliders.include[c]) colliderDistanceBounds(model.colliders[c], poses[c], p.x[0].data(), n, scratch.colliderBound.data());
+  const float fall = model.solver.gravity.norm() * h;
+  scratch.colliderCandidates.clear();
+  for (const IndexRange& r : colliders.cloth)
+    for (int64_t i = r.begin; i < r.end; ++i) {
+      if (!(p.invMass[i] > 0.0f) || model.clothPinned[i]) continue;
+      float carried = 0.0f;
+      for (size_t c = 0; c < model.colliders.size() && c < poses.size(); ++c)
+        if (colliders.include[c] && poses[c].moving())
+          carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], p.x[i]) * h);
+      const float reach = 2.0f * contactMargin(model, p.phase[i]) + (p.v[i].norm() + fall) * h + carried;
+      if (scratch.colliderBound[i] < reach) scratch.colliderCandidates.push_back(static_cast<int>(i));
+    }
+}
+
+}  // namespace
+
+void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h,
+               const SmallStepColliders* colliders) {
+  const int n = model.numCloth;
+  scratch.colliderPutBack = 0;
   const int steps = std::max(1, model.solver.clothSubsteps);
   const int iterations = model.solver.clothIterations;
   scratch.selfCollisionMs = 0.0;
@@ -36,6 +69,12 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
   const auto moves = [&](int64_t i) { return !model.clothPinned[i] && !model.clothImplicit[i]; };
   scratch.stepPosition.resize(n);
   scratch.stepVelocity.resize(n);
+  scratch.stepStart.resize(n);
+  // the colliders in each small step too: met only after them, a resting cloth's small steps slid and
+  // sank freely and the substep's friction took the slip back from x*, leaving the last small step's
+  // velocity stored in the contact (docs/models.md, "Colliders in the small steps")
+  const bool contact = colliders && static_cast<int>(colliders->poses.size()) == steps;
+  if (contact) findColliderCandidates(model, *colliders, p, h, scratch);
   Vec3* y = scratch.stepPosition.data();
   Vec3* u = scratch.stepVelocity.data();
   // the substep's start: x and the velocity before predictPositions added h g
@@ -49,6 +88,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
       u[i] += hs * g;
+      scratch.stepStart[i] = y[i];
       p.xPred[i] = y[i] + hs * u[i];
       y[i] = p.xPred[i];
     });
@@ -57,6 +97,9 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     clock.lap();
     collideSelfCollisionPairs(model, p, scratch);
     scratch.selfCollisionMs += clock.lap();
+    if (contact)
+      scratch.colliderPutBack += projectColliders(model, colliders->poses[s], p, scratch.colliderCandidates,
+                                                  scratch.stepStart.data(), colliders->include, hs);
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
       u[i] += (p.xPred[i] - y[i]) / hs;

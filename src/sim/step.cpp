@@ -51,9 +51,39 @@ void predict(const Model& model, State& state, Workspace& ws, float h, std::span
   clock.lap(stats.ms.garment);
 }
 
+// the colliders' poses at the end of each of the PBD cloth's small steps of the substep that starts at
+// t, and which colliders take part: a moving mesh sequence would build its surface's tree in every
+// small step, so it meets the cloth once a substep, with the water (no small steps: nothing)
+const SmallStepColliders* smallStepColliders(const Model& model, Workspace& ws, double t, float h,
+                                             std::span<const std::vector<Keyframe>> colliderKeys) {
+  const int steps = model.solver.clothSubsteps;
+  SmallStepColliders& c = ws.clothColliders;
+  c.cloth.clear();
+  for (const IndexRange& r : ws.pbdParticles)
+    if (r.begin < model.numCloth) c.cloth.push_back({r.begin, std::min<int64_t>(r.end, model.numCloth)});
+  if (steps <= 1 || c.cloth.empty() || model.colliders.empty()) return nullptr;
+  const size_t count = model.colliders.size();
+  c.include.assign(count, 1);
+  c.poses.resize(static_cast<size_t>(steps));
+  for (int s = 0; s < steps; ++s) c.poses[s] = ws.poses;  // a still collider: its pose at the substep's end
+  for (size_t k = 0; k < count; ++k) {
+    if (!ws.poses[k].moving()) continue;
+    if (model.colliders[k].shape == ColliderShape::MeshSequence) {
+      c.include[k] = 0;
+      continue;
+    }
+    const bool given = k < colliderKeys.size() && !colliderKeys[k].empty();
+    const std::span<const Keyframe> keys = given ? colliderKeys[k] : model.colliders[k].keys;
+    for (int s = 0; s + 1 < steps; ++s)
+      c.poses[s][k] = colliderPose(model.colliders[k], keys, t + h * static_cast<double>(s + 1) / steps);
+  }
+  return &c;
+}
+
 // the constraints on x*: water (Eq. 6-7) with the cloth as its boundary, cloth (Eq. 8-9), colliders
 // and the water-cloth coupling (Eq. 21-22)
-void project(const Model& model, State& state, Workspace& ws, float h, StepStats& stats, StageClock& clock) {
+void project(const Model& model, State& state, Workspace& ws, float h, std::span<const std::vector<Keyframe>> colliderKeys,
+             StepStats& stats, StageClock& clock) {
   Particles& p = state.particles;
   StageTimes& ms = stats.ms;
   buildGrid(p.xPred, neighborCellSize(model, p), ws.grid);                         // neighbours of x*
@@ -68,7 +98,9 @@ void project(const Model& model, State& state, Workspace& ws, float h, StepStats
   stats.fluidIterations += static_cast<uint64_t>(its);
   stats.fluidIterationsMax = std::max(stats.fluidIterationsMax, its);
   clock.lap(ms.water);
-  stepCloth(model, p, ws.neighbors, ws.cloth, h);                                   // small steps: tethers, Eq. 8, Eq. 9, self-collision
+  stepCloth(model, p, ws.neighbors, ws.cloth, h,                                    // small steps: tethers, Eq. 8, Eq. 9,
+            smallStepColliders(model, ws, state.time, h, colliderKeys));              // self-collision, colliders
+  stats.colliderPutBack += ws.cloth.colliderPutBack;
   clock.lap(ms.cloth, StagePart::clothSolve, StagePart::clothSelfCollision, ws.cloth.selfCollisionMs);
   stats.colliderPutBack += projectColliders(model, ws.poses, p, ws.pbdParticles, h, ws.contactNormal,
                                             ws.colliderBound);                       // Coulomb friction
@@ -121,7 +153,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
              std::span<const std::vector<Keyframe>> colliderKeys, StepStats& stats) {
   StageClock clock{stats.ms, LapClock{}};
   predict(model, state, ws, h, colliderKeys, stats, clock);                         // x* = x + dt v
-  project(model, state, ws, h, stats, clock);                                       // neighbours, constraints
+  project(model, state, ws, h, colliderKeys, stats, clock);                                       // neighbours, constraints
   updateVelocitiesAndCommit(model, ws, state.particles, h, stats, clock);           // v, then x = x*
   if (wetDt > 0.0f) wet(model, state, ws, wetDt, clock);                            // absorb, diffuse, drip, stick
   clock.lap(stats.ms.wetting);

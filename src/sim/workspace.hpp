@@ -23,6 +23,7 @@ struct Workspace {
   std::vector<float> colliderBound;     // projectColliders' scratch: a lower bound of the distance to the colliders
   FluidScratch fluid;
   ClothScratch cloth;
+  SmallStepColliders clothColliders;    // the colliders in the PBD cloth's small steps (smallStepColliders)
   CouplingScratch coupling;
   std::vector<uint8_t> keep;            // particles kept after the domain check
   std::vector<IndexRange> pbdParticles; // the particles the PBD stages move this substep (pbdParticles)

@@ -176,6 +176,57 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
   return projectColliders(model, poses, p, {{0, static_cast<int64_t>(p.size())}}, dt, contactNormal, distanceBound);
 }
 
+namespace {
+
+// the contact parts of the colliders that take part (include empty: all) at `poses`
+struct ContactSet {
+  std::vector<ContactPart> parts;
+  bool anyMoves = false;
+};
+
+ContactSet contactSet(const Model& model, const std::vector<ColliderPose>& poses, std::span<const uint8_t> include) {
+  const size_t count = std::min(model.colliders.size(), poses.size());
+  const auto takesPart = [&](size_t c) { return include.empty() || (c < include.size() && include[c]); };
+  ContactSet set;
+  set.parts = contactParts(model, poses, count);
+  std::erase_if(set.parts, [&](const ContactPart& part) { return !takesPart(part.owner); });
+  for (size_t c = 0; c < count; ++c) set.anyMoves = set.anyMoves || (takesPart(c) && poses[c].moving());
+  return set;
+}
+
+// particle i's step from x to p.xPred[i] against the set (bound: a lower bound of x*'s distance to it):
+// x* put out and its friction applied, normal the last contact's; returns whether it was put back
+bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses, const ContactSet& set, Particles& p,
+                     int64_t i, const Vec3& x, float dt, float bound, Vec3& normal) {
+  const float margin = contactMargin(model, p.phase[i]);
+  float carried = 0.0f;  // how far the colliders carry the start in this step
+  for (const ContactPart& part : set.parts)
+    if (set.anyMoves) carried = std::max(carried, colliderSpeedBound(model.colliders[part.owner], poses[part.owner], x) * dt);
+  Vec3 xp = p.xPred[i];
+  if (bound >= margin + (xp - x).norm() + carried) return false;
+  // a push out of one part can put x* into another met before it (a container's wall after its
+  // neighbour's): up to three passes, each later one over the parts before the last that pushed,
+  // only pushing out
+  int caught = 0;
+  size_t end = set.parts.size();
+  for (int pass = 0; pass < kContactPasses && end > 0; ++pass) {
+    size_t lastPush = 0;
+    for (size_t k = 0; k < end; ++k) {
+      const ContactPart& part = set.parts[k];
+      const Collider& owner = model.colliders[part.owner];
+      const ContactResult r = contactWith(part, owner, poses[part.owner], x, xp, margin, dt,
+                                          frictionOf(model, owner, p.phase[i]), pass > 0, &normal);
+      caught += r.putBack ? 1 : 0;
+      if (r.touched) lastPush = k;
+    }
+    end = lastPush;
+  }
+  p.xPred[i] = xp;
+  return caught > 0;
+}
+
+}  // namespace
+
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
                           const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
                           std::vector<float>& distanceBound) {
@@ -188,37 +239,26 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
   distanceBound.assign(p.size(), std::numeric_limits<float>::max());
   for (size_t c = 0; c < numColliders; ++c)
     colliderDistanceBounds(model.colliders[c], poses[c], p.xPred[0].data(), n, distanceBound.data());
-  const std::vector<ContactPart> parts = contactParts(model, poses, numColliders);
-  const bool anyMoves =
-      std::any_of(poses.begin(), poses.begin() + numColliders, [](const ColliderPose& pose) { return pose.moving(); });
+  const ContactSet set = contactSet(model, poses, {});
   std::atomic<uint64_t> putBack{0};
   parallelForRanges(moved, [&](int64_t i) {
     if (!(p.invMass[i] > 0.0f)) return;
-    const float margin = contactMargin(model, p.phase[i]);
-    float carried = 0.0f;  // how far the colliders carry the start in this substep
-    for (size_t c = 0; anyMoves && c < numColliders; ++c)
-      carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], p.x[i]) * dt);
-    Vec3 xp = p.xPred[i];
-    if (distanceBound[i] >= margin + (xp - p.x[i]).norm() + carried) return;
-    // a push out of one part can put x* into another met before it (a container's wall after its
-    // neighbour's): up to three passes, each later one over the parts before the last that pushed,
-    // only pushing out
-    int caught = 0;
-    size_t end = parts.size();
-    for (int pass = 0; pass < kContactPasses && end > 0; ++pass) {
-      size_t lastPush = 0;
-      for (size_t k = 0; k < end; ++k) {
-        const ContactPart& part = parts[k];
-        const Collider& owner = model.colliders[part.owner];
-        const ContactResult r = contactWith(part, owner, poses[part.owner], p.x[i], xp, margin, dt,
-                                            frictionOf(model, owner, p.phase[i]), pass > 0, &contactNormal[i]);
-        caught += r.putBack ? 1 : 0;
-        if (r.touched) lastPush = k;
-      }
-      end = lastPush;
-    }
-    p.xPred[i] = xp;
-    if (caught) putBack.fetch_add(1, std::memory_order_relaxed);
+    if (contactParticle(model, poses, set, p, i, p.x[i], dt, distanceBound[i], contactNormal[i]))
+      putBack.fetch_add(1, std::memory_order_relaxed);
+  });
+  return putBack.load();
+}
+
+uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
+                          std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include, float dt) {
+  if (particles.empty() || model.colliders.empty() || poses.empty()) return 0;
+  const ContactSet set = contactSet(model, poses, include);
+  std::atomic<uint64_t> putBack{0};
+  parallelFor(static_cast<int64_t>(particles.size()), [&](int64_t k) {
+    const int i = particles[k];
+    Vec3 normal = Vec3::Zero();
+    if (p.invMass[i] > 0.0f && contactParticle(model, poses, set, p, i, start[i], dt, 0.0f, normal))
+      putBack.fetch_add(1, std::memory_order_relaxed);
   });
   return putBack.load();
 }

@@ -102,6 +102,11 @@ float contactMargin(const Model& model, int32_t phase);
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
                       const std::vector<IndexRange>& moved, float dt, std::vector<Vec3>& contactNormal,
                       std::vector<float>& distanceBound);
+// the same for the listed particles over a step that started at start[i] instead of x (the PBD
+// cloth's small steps, pbd/cloth_steps.cpp), against the colliders whose `include` flag is set (empty:
+// all); no contact normals are kept
+uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
+                          std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include, float dt);
 // the same for every particle
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal);

@@ -92,3 +92,105 @@ TEST(ClothSteps, SameStateOnOneTwoAndThreeThreads) {
   EXPECT_EQ(hashes[0], hashes[1]);
   EXPECT_EQ(hashes[0], hashes[2]);
 }
+
+namespace {
+
+// a 0.3 m sheet (30 x 30) dropped on a ball of radius 0.1 m (friction 0.5) that stands still for
+// 1.2 s and then sinks at 0.25 m/s
+const char* kSheetOnBall = R"({
+  "solver": {"dt": 0.015, "substeps": 2, "clothSubsteps": 16, "clothIterations": 1, "domain": {"min": [-2, -2, -2], "max": [2, 3, 2]}},
+  "cloth": [{"mesh": {"type": "rectangle", "center": [0, 0.62, 0], "size": [0.3, 0.3], "resolution": [30, 30],
+                      "axisU": [1, 0, 0], "axisV": [0, 0, 1]},
+             "material": {"particleMass": 0.0066, "restDensity": 800}}],
+  "colliders": [{"name": "ball", "type": "sphere", "radius": 0.1, "friction": 0.5,
+                 "keyframes": [{"time": 0, "position": [0, 0.5, 0]}, {"time": 1.2, "position": [0, 0.5, 0]},
+                               {"time": 1.8, "position": [0, 0.35, 0]}]}]})";
+
+// over one more step of the scene: the mean over the cloth on the ball's cap (within 30 degrees of its
+// top, in contact) of the stored velocity after the step and of the velocity its positions show
+// (x_after - x_before) / dt; and how far apart the two are per particle, mean |v - dx/dt|
+struct CapVelocity {
+  Vec3 stored = Vec3::Zero(), moved = Vec3::Zero();
+  float mismatch = 0.0f;
+  int count = 0;
+};
+
+CapVelocity capVelocity(Scene& scene, const Vec3& centre) {
+  const std::vector<Vec3> before = scene.state.particles.x;
+  runSteps(scene, 1);
+  const Particles& p = scene.state.particles;
+  const float dt = scene.model.solver.dt, radius = 0.1f, margin = 0.5f * scene.model.pieces[0].material.thickness;
+  CapVelocity cap;
+  for (int i = 0; i < scene.model.numCloth; ++i) {
+    const Vec3 r = before[i] - centre;
+    if (r.norm() > radius + 2.0f * margin || r.y() < std::cos(0.52f) * radius) continue;
+    const Vec3 moved = (p.x[i] - before[i]) / dt;
+    cap.stored += p.v[i];
+    cap.moved += moved;
+    cap.mismatch += (p.v[i] - moved).norm();
+    ++cap.count;
+  }
+  if (cap.count == 0) return cap;
+  cap.stored /= static_cast<float>(cap.count);
+  cap.moved /= static_cast<float>(cap.count);
+  cap.mismatch /= static_cast<float>(cap.count);
+  return cap;
+}
+
+}  // namespace
+
+// the colliders act in every small step: the velocity the cloth resting on a ball keeps is the one its
+// positions show, still or carried. Met only once a substep, after the small steps, the cap kept 0.4
+// m/s of velocity stored into the ball's friction while its positions moved by 0.01 m/s, and sinking
+// with the ball it kept 0.3 m/s down at 0.25
+TEST(ClothSteps, ClothOnABallKeepsTheVelocityItsPositionsShow) {
+  Scene scene = sceneFromJson(kSheetOnBall);
+  runSteps(scene, 66);  // 0.99 s: settled on the still ball
+  const CapVelocity still = capVelocity(scene, Vec3(0, 0.5f, 0));
+  ASSERT_GT(still.count, 30);
+  EXPECT_LT(still.mismatch, 0.05f);
+  EXPECT_LT((still.stored - still.moved).norm(), 0.01f);
+  runSteps(scene, 33);  // 1.5 s: the ball sinking at 0.25 m/s for 0.3 s
+  const float t = 1.5f;
+  const CapVelocity sinking = capVelocity(scene, Vec3(0, 0.5f - 0.25f * (t - 1.2f), 0));
+  ASSERT_GT(sinking.count, 30);
+  EXPECT_NEAR(sinking.stored.y(), -0.25f, 0.025f);
+  EXPECT_NEAR(sinking.moved.y(), -0.25f, 0.025f);
+  EXPECT_LT(sinking.mismatch, 0.05f);
+}
+
+// Coulomb friction in the small steps: a sheet lying on a slope (mu_s 0.5, mu_k 0.3, the plane's and
+// the cloth's alike) holds while tan(theta) <= mu_s and slides with a = g (sin theta - mu_k cos theta)
+// above it, with 16 small steps a substep as with one step (the friction then acts once a substep)
+TEST(ClothSteps, ASheetOnASlopeHoldsOrSlidesByCoulombsLawInTheSmallSteps) {
+  const float time = 0.51f, g = 9.81f;
+  for (const float slope : {0.4f, 0.7f}) {
+    const float theta = std::atan(slope);
+    const Vec3 n(-std::sin(theta), std::cos(theta), 0.0f), down(-std::cos(theta), -std::sin(theta), 0.0f);
+    const auto vec = [](const Vec3& v) {
+      return "[" + std::to_string(v.x()) + ", " + std::to_string(v.y()) + ", " + std::to_string(v.z()) + "]";
+    };
+    const std::string json = R"({
+  "solver": {"dt": 0.015, "substeps": 2, "clothSubsteps": 16, "clothIterations": 1, "domain": {"min": [-3, -3, -3], "max": [3, 3, 3]}},
+  "cloth": [{"mesh": {"type": "rectangle", "center": )" + vec(0.005f * n) + R"(, "size": [0.1, 0.1], "resolution": [10, 10],
+                      "axisU": )" + vec(-down) + R"(, "axisV": [0, 0, 1]},
+             "material": {"particleMass": 0.0066, "restDensity": 800, "thickness": 0.01, "friction": 0.3, "staticFriction": 0.5}}],
+  "colliders": [{"name": "slope", "type": "plane", "normal": )" + vec(n) + R"(, "friction": 0.3, "staticFriction": 0.5}]})";
+    for (const int smallSteps : {1, 16}) {
+      Scene scene = sceneFromJson(json, {"solver.clothSubsteps=" + std::to_string(smallSteps)});
+      const std::vector<Vec3> start = scene.state.particles.x;
+      runSteps(scene, static_cast<int>(std::lround(time / 0.015f)));
+      Vec3 travelled = Vec3::Zero();
+      float height = 0.0f;
+      for (int i = 0; i < scene.model.numCloth; ++i) {
+        travelled += scene.state.particles.x[i] - start[i];
+        height = std::max(height, std::abs(scene.state.particles.x[i].dot(n) - 0.005f));
+      }
+      travelled /= static_cast<float>(scene.model.numCloth);
+      const float a = g * (std::sin(theta) - 0.3f * std::cos(theta));
+      const float expected = slope <= 0.5f ? 0.0f : 0.5f * a * time * time;
+      EXPECT_NEAR(travelled.dot(down), expected, 0.03f * expected + 1e-4f) << "slope " << slope << ", " << smallSteps << " small steps";
+      EXPECT_LT(height, 1e-3f) << "slope " << slope << ", " << smallSteps << " small steps";  // lies on the plane
+    }
+  }
+}
