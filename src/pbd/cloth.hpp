@@ -37,7 +37,7 @@ struct ClothScratch {
   uint64_t colliderPutBack = 0;      // the small steps' collider put-backs of the last stepCloth
 };
 
-// the colliders the PBD cloth meets in each of its small steps (step.cpp fills it; smallStepPoses)
+// the colliders the PBD cloth meets in each of its small steps (step.cpp fills it: smallStepColliders)
 struct SmallStepColliders {
   std::vector<std::vector<ColliderPose>> poses;  // the colliders' poses at the end of each small step
   std::vector<uint8_t> include;                  // the colliders that take part: all but a moving mesh sequence

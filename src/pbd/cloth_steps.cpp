@@ -23,7 +23,8 @@ void findColliderCandidates(const Model& model, const SmallStepColliders& collid
   const std::vector<ColliderPose>& poses = colliders.poses.back();
   scratch.colliderBound.assign(static_cast<size_t>(n), std::numeric_limits<float>::max());
   for (size_t c = 0; c < model.colliders.size() && c < poses.size(); ++c)
-    if (colliders.include[c]) colliderDistanceBounds(model.colliders[c], poses[c], p.x[0].data(), n, scratch.colliderBound.data());
+    if (colliders.include[c])
+      colliderDistanceBounds(model.colliders[c], poses[c], p.x[0].data(), n, scratch.colliderBound.data());
   const float fall = model.solver.gravity.norm() * h;
   scratch.colliderCandidates.clear();
   for (const IndexRange& r : colliders.cloth)
@@ -72,7 +73,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
   scratch.stepStart.resize(n);
   // the colliders in each small step too: met only after them, a resting cloth's small steps slid and
   // sank freely and the substep's friction took the slip back from x*, leaving the last small step's
-  // velocity stored in the contact (docs/models.md, "Colliders in the small steps")
+  // velocity stored in the contact (docs/models.md, "Colliders")
   const bool contact = colliders && static_cast<int>(colliders->poses.size()) == steps;
   if (contact) findColliderCandidates(model, *colliders, p, h, scratch);
   Vec3* y = scratch.stepPosition.data();

@@ -82,8 +82,8 @@ const SmallStepColliders* smallStepColliders(const Model& model, Workspace& ws, 
 
 // the constraints on x*: water (Eq. 6-7) with the cloth as its boundary, cloth (Eq. 8-9), colliders
 // and the water-cloth coupling (Eq. 21-22)
-void project(const Model& model, State& state, Workspace& ws, float h, std::span<const std::vector<Keyframe>> colliderKeys,
-             StepStats& stats, StageClock& clock) {
+void project(const Model& model, State& state, Workspace& ws, float h,
+             std::span<const std::vector<Keyframe>> colliderKeys, StepStats& stats, StageClock& clock) {
   Particles& p = state.particles;
   StageTimes& ms = stats.ms;
   buildGrid(p.xPred, neighborCellSize(model, p), ws.grid);                         // neighbours of x*
@@ -153,7 +153,7 @@ void substep(const Model& model, State& state, Workspace& ws, float h, float wet
              std::span<const std::vector<Keyframe>> colliderKeys, StepStats& stats) {
   StageClock clock{stats.ms, LapClock{}};
   predict(model, state, ws, h, colliderKeys, stats, clock);                         // x* = x + dt v
-  project(model, state, ws, h, colliderKeys, stats, clock);                                       // neighbours, constraints
+  project(model, state, ws, h, colliderKeys, stats, clock);                         // neighbours, constraints
   updateVelocitiesAndCommit(model, ws, state.particles, h, stats, clock);           // v, then x = x*
   if (wetDt > 0.0f) wet(model, state, ws, wetDt, clock);                            // absorb, diffuse, drip, stick
   clock.lap(stats.ms.wetting);

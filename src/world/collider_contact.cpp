@@ -200,8 +200,10 @@ bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses,
                      int64_t i, const Vec3& x, float dt, float bound, Vec3& normal) {
   const float margin = contactMargin(model, p.phase[i]);
   float carried = 0.0f;  // how far the colliders carry the start in this step
-  for (const ContactPart& part : set.parts)
-    if (set.anyMoves) carried = std::max(carried, colliderSpeedBound(model.colliders[part.owner], poses[part.owner], x) * dt);
+  for (size_t k = 0; set.anyMoves && k < set.parts.size(); ++k) {
+    const size_t c = set.parts[k].owner;
+    carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], x) * dt);
+  }
   Vec3 xp = p.xPred[i];
   if (bound >= margin + (xp - x).norm() + carried) return false;
   // a push out of one part can put x* into another met before it (a container's wall after its
@@ -250,7 +252,8 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
 }
 
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
-                          std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include, float dt) {
+                          std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include,
+                          float dt) {
   if (particles.empty() || model.colliders.empty() || poses.empty()) return 0;
   const ContactSet set = contactSet(model, poses, include);
   std::atomic<uint64_t> putBack{0};

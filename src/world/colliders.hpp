@@ -106,7 +106,8 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
 // cloth's small steps, pbd/cloth_steps.cpp), against the colliders whose `include` flag is set (empty:
 // all); no contact normals are kept
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
-                          std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include, float dt);
+                          std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include,
+                          float dt);
 // the same for every particle
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal);

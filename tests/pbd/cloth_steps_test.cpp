@@ -189,8 +189,9 @@ TEST(ClothSteps, ASheetOnASlopeHoldsOrSlidesByCoulombsLawInTheSmallSteps) {
       travelled /= static_cast<float>(scene.model.numCloth);
       const float a = g * (std::sin(theta) - 0.3f * std::cos(theta));
       const float expected = slope <= 0.5f ? 0.0f : 0.5f * a * time * time;
-      EXPECT_NEAR(travelled.dot(down), expected, 0.03f * expected + 1e-4f) << "slope " << slope << ", " << smallSteps << " small steps";
-      EXPECT_LT(height, 1e-3f) << "slope " << slope << ", " << smallSteps << " small steps";  // lies on the plane
+      const std::string what = "slope " + std::to_string(slope) + ", " + std::to_string(smallSteps) + " small steps";
+      EXPECT_NEAR(travelled.dot(down), expected, 0.03f * expected + 1e-4f) << what;
+      EXPECT_LT(height, 1e-3f) << what;  // lies on the plane
     }
   }
 }
