@@ -12,6 +12,7 @@ struct SolverParams {
   float fluidTolerance = 0.01f;   // mean over the water of max(rho_i / rho_0 - 1, 0) the extra iterations stop at
   int clothSubsteps = 1;          // small steps the PBD cloth takes per substep (Macklin et al. 2019)
   int clothIterations = 8;        // cloth constraint iterations per small step
+  bool clothCollidersInSmallSteps = true;  // colliders meet the PBD cloth in each small step (false: once a substep)
   int couplingIterations = 2;     // water-cloth coupling passes per substep (Eq. 21)
   Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2
   Vec3 domainMin{-10.0f, -10.0f, -10.0f};  // m; particles leaving this box are removed and counted

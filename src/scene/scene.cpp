@@ -105,6 +105,7 @@ void readSolver(ObjectReader r, SolverParams& s, float& maxMemoryGB) {
   s.fluidTolerance = r.number("fluidTolerance", d.fluidTolerance, Range::positive());
   s.clothSubsteps = r.integer("clothSubsteps", d.clothSubsteps, loops);
   s.clothIterations = r.integer("clothIterations", d.clothIterations, loops0);
+  s.clothCollidersInSmallSteps = r.boolean("clothCollidersInSmallSteps", d.clothCollidersInSmallSteps);
   s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, loops0);
   s.gravity = r.vec3("gravity", d.gravity);
   ObjectReader dom = r.object("domain");

@@ -53,7 +53,8 @@ void predict(const Model& model, State& state, Workspace& ws, float h, std::span
 
 // the colliders' poses at the end of each of the PBD cloth's small steps of the substep that starts at
 // t, and which colliders take part: a moving mesh sequence would build its surface's tree in every
-// small step, so it meets the cloth once a substep, with the water (no small steps: nothing)
+// small step, so it meets the cloth once a substep, with the water (no small steps or
+// solver.clothCollidersInSmallSteps false: nothing)
 const SmallStepColliders* smallStepColliders(const Model& model, Workspace& ws, double t, float h,
                                              std::span<const std::vector<Keyframe>> colliderKeys) {
   const int steps = model.solver.clothSubsteps;
@@ -61,7 +62,8 @@ const SmallStepColliders* smallStepColliders(const Model& model, Workspace& ws, 
   c.cloth.clear();
   for (const IndexRange& r : ws.pbdParticles)
     if (r.begin < model.numCloth) c.cloth.push_back({r.begin, std::min<int64_t>(r.end, model.numCloth)});
-  if (steps <= 1 || c.cloth.empty() || model.colliders.empty()) return nullptr;
+  if (steps <= 1 || c.cloth.empty() || model.colliders.empty() || !model.solver.clothCollidersInSmallSteps)
+    return nullptr;
   const size_t count = model.colliders.size();
   c.include.assign(count, 1);
   c.poses.resize(static_cast<size_t>(steps));
