@@ -40,7 +40,7 @@ struct ClothScratch {
 // the colliders the PBD cloth meets in each of its small steps (step.cpp fills it: smallStepColliders)
 struct SmallStepColliders {
   std::vector<std::vector<ColliderPose>> poses;  // the colliders' poses at the end of each small step
-  std::vector<uint8_t> include;                  // the colliders that take part: all but a moving mesh sequence
+  std::vector<uint8_t> include;                  // 1 for each collider, kPosedAhead for a moving mesh sequence
   std::vector<IndexRange> cloth;                 // the PBD cloth's particles
 };
 

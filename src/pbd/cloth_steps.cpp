@@ -100,7 +100,8 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     scratch.selfCollisionMs += clock.lap();
     if (contact)
       scratch.colliderPutBack += projectColliders(model, colliders->poses[s], p, scratch.colliderCandidates,
-                                                  scratch.stepStart.data(), colliders->include, hs);
+                                                  scratch.stepStart.data(), colliders->include, hs,
+                                                  static_cast<float>(steps - 1 - s) * hs);
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
       u[i] += (p.xPred[i] - y[i]) / hs;

@@ -52,9 +52,9 @@ void predict(const Model& model, State& state, Workspace& ws, float h, std::span
 }
 
 // the colliders' poses at the end of each of the PBD cloth's small steps of the substep that starts at
-// t, and which colliders take part: a moving mesh sequence would build its surface's tree in every
-// small step, so it meets the cloth once a substep, with the water (no small steps or
-// solver.clothCollidersInSmallSteps false: nothing)
+// t. A moving mesh sequence would build its surface's tree in every small step: it keeps the substep's
+// end pose and each small step meets it ahead by its surface's velocity (kPosedAhead). Nothing without
+// small steps or with solver.clothCollidersInSmallSteps false
 const SmallStepColliders* smallStepColliders(const Model& model, Workspace& ws, double t, float h,
                                              std::span<const std::vector<Keyframe>> colliderKeys) {
   const int steps = model.solver.clothSubsteps;
@@ -71,7 +71,7 @@ const SmallStepColliders* smallStepColliders(const Model& model, Workspace& ws, 
   for (size_t k = 0; k < count; ++k) {
     if (!ws.poses[k].moving()) continue;
     if (model.colliders[k].shape == ColliderShape::MeshSequence) {
-      c.include[k] = 0;
+      c.include[k] = kPosedAhead;  // posed at the substep's end, met ahead of each small step's end
       continue;
     }
     const bool given = k < colliderKeys.size() && !colliderKeys[k].empty();

@@ -195,9 +195,11 @@ ContactSet contactSet(const Model& model, const std::vector<ColliderPose>& poses
 }
 
 // particle i's step from x to p.xPred[i] against the set (bound: a lower bound of x*'s distance to it):
-// x* put out and its friction applied, normal the last contact's; returns whether it was put back
+// x* put out and its friction applied, normal the last contact's; returns whether it was put back. A
+// part whose owner is flagged kPosedAhead in `include` is met `ahead` seconds on (projectColliders)
 bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses, const ContactSet& set, Particles& p,
-                     int64_t i, const Vec3& x, float dt, float bound, Vec3& normal) {
+                     int64_t i, const Vec3& x, float dt, float bound, Vec3& normal,
+                     std::span<const uint8_t> include = {}, float ahead = 0.0f) {
   const float margin = contactMargin(model, p.phase[i]);
   float carried = 0.0f;  // how far the colliders carry the start in this step
   for (size_t k = 0; set.anyMoves && k < set.parts.size(); ++k) {
@@ -216,8 +218,13 @@ bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses,
     for (size_t k = 0; k < end; ++k) {
       const ContactPart& part = set.parts[k];
       const Collider& owner = model.colliders[part.owner];
-      const ContactResult r = contactWith(part, owner, poses[part.owner], x, xp, margin, dt,
+      // a surface posed ahead: the step carried to it by the surface's velocity, and back after
+      const bool posedAhead = ahead > 0.0f && part.owner < include.size() && include[part.owner] == kPosedAhead;
+      const Vec3 carry = posedAhead ? Vec3(colliderVelocity(owner, poses[part.owner], xp) * ahead) : Vec3::Zero();
+      xp += carry;
+      const ContactResult r = contactWith(part, owner, poses[part.owner], x + carry, xp, margin, dt,
                                           frictionOf(model, owner, p.phase[i]), pass > 0, &normal);
+      xp -= carry;
       caught += r.putBack ? 1 : 0;
       if (r.touched) lastPush = k;
     }
@@ -253,14 +260,14 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
 
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
                           std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include,
-                          float dt) {
+                          float dt, float ahead) {
   if (particles.empty() || model.colliders.empty() || poses.empty()) return 0;
   const ContactSet set = contactSet(model, poses, include);
   std::atomic<uint64_t> putBack{0};
   parallelFor(static_cast<int64_t>(particles.size()), [&](int64_t k) {
     const int i = particles[k];
     Vec3 normal = Vec3::Zero();
-    if (p.invMass[i] > 0.0f && contactParticle(model, poses, set, p, i, start[i], dt, 0.0f, normal))
+    if (p.invMass[i] > 0.0f && contactParticle(model, poses, set, p, i, start[i], dt, 0.0f, normal, include, ahead))
       putBack.fetch_add(1, std::memory_order_relaxed);
   });
   return putBack.load();

@@ -104,10 +104,13 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
                       std::vector<float>& distanceBound);
 // the same for the listed particles over a step that started at start[i] instead of x (the PBD
 // cloth's small steps, pbd/cloth_steps.cpp), against the colliders whose `include` flag is set (empty:
-// all); no contact normals are kept
+// all); no contact normals are kept. A collider flagged kPosedAhead is posed `ahead` seconds after the
+// step's end (a moving mesh sequence posed once a substep): the particle meets it carried that far by
+// the surface's velocity where it is, and is carried back after
+constexpr uint8_t kPosedAhead = 2;
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p,
                           std::span<const int> particles, const Vec3* start, std::span<const uint8_t> include,
-                          float dt);
+                          float dt, float ahead = 0.0f);
 // the same for every particle
 uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& poses, Particles& p, float dt,
                       std::vector<Vec3>& contactNormal);
