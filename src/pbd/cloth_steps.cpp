@@ -70,12 +70,14 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
   const auto moves = [&](int64_t i) { return !model.clothPinned[i] && !model.clothImplicit[i]; };
   scratch.stepPosition.resize(n);
   scratch.stepVelocity.resize(n);
-  scratch.stepStart.resize(n);
   // the colliders in each small step too: met only after them, a resting cloth's small steps slid and
   // sank freely and the substep's friction took the slip back from x*, leaving the last small step's
   // velocity stored in the contact (docs/models.md, "Colliders")
   const bool contact = colliders && static_cast<int>(colliders->poses.size()) == steps;
-  if (contact) findColliderCandidates(model, *colliders, p, h, scratch);
+  if (contact) {
+    scratch.stepStart.resize(n);
+    findColliderCandidates(model, *colliders, p, h, scratch);
+  }
   Vec3* y = scratch.stepPosition.data();
   Vec3* u = scratch.stepVelocity.data();
   // the substep's start: x and the velocity before predictPositions added h g
@@ -89,7 +91,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
       u[i] += hs * g;
-      scratch.stepStart[i] = y[i];
+      if (contact) scratch.stepStart[i] = y[i];
       p.xPred[i] = y[i] + hs * u[i];
       y[i] = p.xPred[i];
     });

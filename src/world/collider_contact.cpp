@@ -24,6 +24,7 @@ struct ContactPart {
   ColliderPose pose;  // of the shape (for a wall, its centre); the velocity field is the owner's
   size_t owner = 0;   // index of the collider in the model and in poses
   float thickness = 0.0f;  // m, the thinnest the part is (a plane: infinite)
+  bool posedAhead = false;  // posed `ahead` seconds after the step's end (kPosedAhead, projectColliders)
 };
 
 float thicknessOf(const Collider& c) {
@@ -190,24 +191,27 @@ ContactSet contactSet(const Model& model, const std::vector<ColliderPose>& poses
   ContactSet set;
   set.parts = contactParts(model, poses, count);
   std::erase_if(set.parts, [&](const ContactPart& part) { return !takesPart(part.owner); });
+  for (ContactPart& part : set.parts)
+    part.posedAhead = part.owner < include.size() && include[part.owner] == kPosedAhead;
   for (size_t c = 0; c < count; ++c) set.anyMoves = set.anyMoves || (takesPart(c) && poses[c].moving());
   return set;
 }
 
-// particle i's step from x to p.xPred[i] against the set (bound: a lower bound of x*'s distance to it):
-// x* put out and its friction applied, normal the last contact's; returns whether it was put back. A
-// part whose owner is flagged kPosedAhead in `include` is met `ahead` seconds on (projectColliders)
+// particle i's step from x to p.xPred[i] against the set (bound: a lower bound of x*'s distance to it,
+// 0 for none): x* put out and its friction applied, normal the last contact's; returns whether it was
+// put back. A part posed ahead is met `ahead` seconds on (projectColliders)
 bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses, const ContactSet& set, Particles& p,
-                     int64_t i, const Vec3& x, float dt, float bound, Vec3& normal,
-                     std::span<const uint8_t> include = {}, float ahead = 0.0f) {
+                     int64_t i, const Vec3& x, float dt, float bound, Vec3& normal, float ahead = 0.0f) {
   const float margin = contactMargin(model, p.phase[i]);
-  float carried = 0.0f;  // how far the colliders carry the start in this step
-  for (size_t k = 0; set.anyMoves && k < set.parts.size(); ++k) {
-    const size_t c = set.parts[k].owner;
-    carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], x) * dt);
-  }
   Vec3 xp = p.xPred[i];
-  if (bound >= margin + (xp - x).norm() + carried) return false;
+  if (bound >= margin) {  // else nothing below can skip the particle
+    float carried = 0.0f;  // how far the colliders carry the start in this step
+    for (size_t k = 0; set.anyMoves && k < set.parts.size(); ++k) {
+      const size_t c = set.parts[k].owner;
+      carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], x) * dt);
+    }
+    if (bound >= margin + (xp - x).norm() + carried) return false;
+  }
   // a push out of one part can put x* into another met before it (a container's wall after its
   // neighbour's): up to three passes, each later one over the parts before the last that pushed,
   // only pushing out
@@ -219,8 +223,8 @@ bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses,
       const ContactPart& part = set.parts[k];
       const Collider& owner = model.colliders[part.owner];
       // a surface posed ahead: the step carried to it by the surface's velocity, and back after
-      const bool posedAhead = ahead > 0.0f && part.owner < include.size() && include[part.owner] == kPosedAhead;
-      const Vec3 carry = posedAhead ? Vec3(colliderVelocity(owner, poses[part.owner], xp) * ahead) : Vec3::Zero();
+      const bool carried = part.posedAhead && ahead > 0.0f;
+      const Vec3 carry = carried ? Vec3(colliderVelocity(owner, poses[part.owner], xp) * ahead) : Vec3::Zero();
       xp += carry;
       const ContactResult r = contactWith(part, owner, poses[part.owner], x + carry, xp, margin, dt,
                                           frictionOf(model, owner, p.phase[i]), pass > 0, &normal);
@@ -267,7 +271,7 @@ uint64_t projectColliders(const Model& model, const std::vector<ColliderPose>& p
   parallelFor(static_cast<int64_t>(particles.size()), [&](int64_t k) {
     const int i = particles[k];
     Vec3 normal = Vec3::Zero();
-    if (p.invMass[i] > 0.0f && contactParticle(model, poses, set, p, i, start[i], dt, 0.0f, normal, include, ahead))
+    if (p.invMass[i] > 0.0f && contactParticle(model, poses, set, p, i, start[i], dt, 0.0f, normal, ahead))
       putBack.fetch_add(1, std::memory_order_relaxed);
   });
   return putBack.load();
