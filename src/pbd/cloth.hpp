@@ -9,6 +9,7 @@
 #include "world/colliders.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace soak {
@@ -17,6 +18,12 @@ namespace soak {
 // constraint per edge; Eq. 9: one bend constraint per interior edge), coloured and scheduled
 // (ConstraintSchedule). Implicit pieces get none: src/garment builds their springs.
 void buildClothConstraints(Model& model);
+
+// the global stretch step's factored system (cloth_global_stretch.cpp)
+struct GlobalStretch;
+struct GlobalStretchDeleter {
+  void operator()(GlobalStretch* g) const;
+};
 
 // scratch for the cloth solver (XPBD multipliers)
 struct ClothScratch {
@@ -35,6 +42,7 @@ struct ClothScratch {
   std::vector<float> colliderBound;  // m, a lower bound of each cloth particle's distance to the colliders
   std::vector<int> colliderCandidates;  // the cloth particles that may meet a collider in the substep
   uint64_t colliderPutBack = 0;      // the small steps' collider put-backs of the last stepCloth
+  std::unique_ptr<GlobalStretch, GlobalStretchDeleter> globalStretch;  // built at the first globalStretchStep
 };
 
 // the colliders the PBD cloth meets in each of its small steps (step.cpp fills it: smallStepColliders)
@@ -63,6 +71,15 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
 // scratch.velocityOffset for updateVelocities. Moves only free PBD cloth. neighbors: the lists of x*.
 void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h,
                const SmallStepColliders* colliders = nullptr);
+
+// solver.clothGlobalStretch: one local/global step of projective dynamics (Bouaziz et al. 2014) on x*
+// over the PBD cloth's inextensible edges (stretch compliance 0): x* + delta minimises
+// sum_i m_i |delta_i|^2 / 2 + w sum_e |x_i - x_j - d_e|^2 / 2, d_e the edge at its rest length along its
+// present direction, w = 1e6 times the mean dry particle mass, held ends fixed; (M_dry + w L) is
+// factored at the first call. Keeps each free piece's momentum (wet masses too); moves only free PBD
+// cloth. stepCloth calls it in each small step, after the constraints (docs/models.md, Eq. 8, "The
+// global stretch step")
+void globalStretchStep(const Model& model, Particles& p, ClothScratch& scratch);
 
 // pushes apart cloth particles of the same piece closer than its thickness d that are not mesh
 // neighbours nor closer than d at rest: delta_i = sum_j w_i/(w_i + w_j) (d - |x_ij|) x_ij/|x_ij|

@@ -53,6 +53,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     scratch.velocityOffset.clear();  // v = (x* - x)/h as it is
     solveTethers(model, p);  // long range attachments first, the iterations smooth what they moved
     solveCloth(model, p, scratch, h, iterations);
+    globalStretchStep(model, p, scratch);
     clock.lap();
     clothSelfCollision(model, p, neighbors, scratch);
     scratch.selfCollisionMs += clock.lap();
@@ -97,6 +98,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     });
     solveTethers(model, p);
     solveCloth(model, p, scratch, hs, iterations);
+    globalStretchStep(model, p, scratch);
     clock.lap();
     collideSelfCollisionPairs(model, p, scratch);
     scratch.selfCollisionMs += clock.lap();
