@@ -1,7 +1,7 @@
 // the PBD cloth's global stretch step (solver.clothGlobalStretch, src/pbd/cloth_global_stretch.cpp): a
 // heavy sheet without tethers hangs inextensible and still; the step keeps a free piece's momentum
-// whatever its wet masses; it leaves compliant edges, held and implicit particles alone; the same
-// state on any thread count
+// whatever its wet masses; it leaves compliant edges and held particles alone, and does nothing
+// unasked; the same state on any thread count; a sheet on a ball rests on it at 4 small steps
 #include "support/run_scene.hpp"
 
 #include "pbd/cloth.hpp"
@@ -39,7 +39,8 @@ float maxStrain(const Scene& scene, const std::vector<Vec3>& x) {
   return worst;
 }
 
-Vec3d momentum(const Particles& p, int n, const std::vector<Vec3>& x) {
+// sum_i m_i x_i: the step's change of it is the momentum it gives, times the step
+Vec3d massMoment(const Particles& p, int n, const std::vector<Vec3>& x) {
   Vec3d sum = Vec3d::Zero();
   for (int i = 0; i < n; ++i) sum += double(p.mass[i]) * x[i].cast<double>();
   return sum;
@@ -48,19 +49,19 @@ Vec3d momentum(const Particles& p, int n, const std::vector<Vec3>& x) {
 }  // namespace
 
 TEST(GlobalStretch, AHeavySheetWithoutTethersHangsInextensibleAndStill) {
-  // measured: 0.04% against 69% without the step at 0.6 s; at rest (1.8 s) |v| below 1e-3 m/s
+  // measured: 0.25% against 139% without the step at 0.6 s; at rest (1.8 s) the fastest particle 1.3e-4 m/s
   Scene off = sceneFromJson(heavySheet(true), {"solver.clothGlobalStretch=false"});
   runSteps(off, 40);
   Scene on = sceneFromJson(heavySheet(true));
   runSteps(on, 40);
   const float strainOff = maxStrain(off, off.state.particles.x), strainOn = maxStrain(on, on.state.particles.x);
-  EXPECT_GT(strainOff, 0.3f);
+  EXPECT_GT(strainOff, 0.5f);
   EXPECT_LT(strainOn, 0.005f);
   runSteps(on, 80);
   const Particles& p = on.state.particles;
   double speed = 0.0;
   for (int i = 0; i < on.model.numCloth; ++i) speed = std::max(speed, double(p.v[i].norm()));
-  EXPECT_LT(speed, 0.005) << "the sheet the step holds still keeps no velocity";
+  EXPECT_LT(speed, 1e-3) << "the sheet the step holds still keeps no velocity";
   EXPECT_LT(maxStrain(on, p.x), 0.005f);
 }
 
@@ -82,10 +83,10 @@ TEST(GlobalStretch, KeepsAFreePiecesMomentumWhateverItsWetMasses) {
       p.xPred[i] = Vec3(0, 1.5f, 0) + 1.05f * r + Vec3(0, 0, 0.02f * std::sin(10.0f * r.x())) +
                    0.01f * Vec3(jitter(rng), jitter(rng), jitter(rng));
     }
-    const Vec3d before = momentum(p, n, p.xPred);
+    const Vec3d before = massMoment(p, n, p.xPred);
     const float strainBefore = maxStrain(scene, p.xPred);
     globalStretchStep(scene.model, p, scratch);
-    const Vec3d after = momentum(p, n, p.xPred);
+    const Vec3d after = massMoment(p, n, p.xPred);
     EXPECT_LT((after - before).norm(), 1e-6 * before.norm()) << "round " << round;
     EXPECT_GT(strainBefore, 0.05f);
     EXPECT_LT(maxStrain(scene, p.xPred), 0.15f * strainBefore) << "round " << round;
