@@ -4,6 +4,8 @@
 // (docs/models.md, Eq. 8, "The global stretch step").
 #include "pbd/cloth.hpp"
 
+#include "core/parallel.hpp"
+
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
@@ -27,6 +29,7 @@ struct GlobalStretch {
   int components = 0;
   double weight = 0.0;          // kg, w
   Ldlt ldlt;
+  Eigen::MatrixXd misfit, delta;  // scratch of each call: the right-hand side r and the solution
 };
 
 namespace {
@@ -109,14 +112,14 @@ void build(const Model& model, const Particles& p, GlobalStretch& g) {
                              "mass is not a finite positive number)");
 }
 
-// delta = A^-1 r, then each component that nothing holds shifted so that sum_i m_i delta_i = 0 with the
-// present (wet) masses: A's dry M gives sum_i m_dry,i delta_i = 0, and L has no other null space, so
-// the shift is all the wet masses change beyond O(m / w)
-Eigen::MatrixXd solve(const Particles& p, const GlobalStretch& g, const Eigen::MatrixXd& r) {
-  Eigen::MatrixXd delta(r.rows(), 3);
-#pragma omp parallel for schedule(static, 1)
-  for (int c = 0; c < 3; ++c) delta.col(c) = g.ldlt.solve(r.col(c));
-  if (g.components == 0) return delta;
+// g.delta = A^-1 g.misfit (a coordinate a thread), then each component that nothing holds shifted so
+// that sum_i m_i delta_i = 0 with the present (wet) masses: A's dry M gives sum_i m_dry,i delta_i = 0,
+// and L has no other null space, so the shift is all the wet masses change beyond O(m / w)
+void solve(const Particles& p, GlobalStretch& g) {
+  Eigen::MatrixXd& delta = g.delta;
+  delta.resize(g.misfit.rows(), 3);
+  parallelFor(3, [&](int64_t c) { delta.col(c) = g.ldlt.solve(g.misfit.col(c)); });
+  if (g.components == 0) return;
   Eigen::MatrixXd momentum = Eigen::MatrixXd::Zero(g.components, 3);
   Eigen::VectorXd mass = Eigen::VectorXd::Zero(g.components);
   for (size_t q = 0; q < g.free.size(); ++q) {
@@ -128,7 +131,6 @@ Eigen::MatrixXd solve(const Particles& p, const GlobalStretch& g, const Eigen::M
   }
   for (size_t q = 0; q < g.free.size(); ++q)
     if (g.component[q] >= 0) delta.row(static_cast<Eigen::Index>(q)) -= momentum.row(g.component[q]) / mass[g.component[q]];
-  return delta;
 }
 
 }  // namespace
@@ -145,11 +147,12 @@ void globalStretchStep(const Model& model, Particles& p, ClothScratch& scratch) 
     scratch.globalStretch.reset(new GlobalStretch);
     build(model, p, *scratch.globalStretch);
   }
-  const GlobalStretch& g = *scratch.globalStretch;
+  GlobalStretch& g = *scratch.globalStretch;
   if (g.free.empty() || g.edges.empty()) return;
   const StretchConstraints& st = model.stretch;
   const Eigen::Index m = static_cast<Eigen::Index>(g.free.size());
-  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(m, 3);
+  Eigen::MatrixXd& r = g.misfit;
+  r.setZero(m, 3);
   for (int k : g.edges) {
     const int i = st.ids[k][0], j = st.ids[k][1];
     const Vec3d e = p.xPred[i].cast<double>() - p.xPred[j].cast<double>();
@@ -159,8 +162,8 @@ void globalStretchStep(const Model& model, Particles& p, ClothScratch& scratch) 
     if (g.row[i] >= 0) r.row(g.row[i]) += f.transpose();
     if (g.row[j] >= 0) r.row(g.row[j]) -= f.transpose();
   }
-  const Eigen::MatrixXd delta = solve(p, g, r);
-  for (Eigen::Index q = 0; q < m; ++q) p.xPred[g.free[q]] += delta.row(q).transpose().cast<float>();
+  solve(p, g);
+  for (Eigen::Index q = 0; q < m; ++q) p.xPred[g.free[q]] += g.delta.row(q).transpose().cast<float>();
 }
 
 }  // namespace soak

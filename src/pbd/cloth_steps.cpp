@@ -30,10 +30,7 @@ void findColliderCandidates(const Model& model, const SmallStepColliders& collid
   for (const IndexRange& r : colliders.cloth)
     for (int64_t i = r.begin; i < r.end; ++i) {
       if (!(p.invMass[i] > 0.0f) || model.clothPinned[i]) continue;
-      float carried = 0.0f;
-      for (size_t c = 0; c < model.colliders.size() && c < poses.size(); ++c)
-        if (colliders.include[c] && poses[c].moving())
-          carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], p.x[i]) * h);
+      const float carried = colliderCarry(model, poses, colliders.include, p.x[i], h);
       const float reach = 2.0f * contactMargin(model, p.phase[i]) + (p.v[i].norm() + fall) * h + carried;
       if (scratch.colliderBound[i] < reach) scratch.colliderCandidates.push_back(static_cast<int>(i));
     }

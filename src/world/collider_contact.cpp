@@ -182,6 +182,7 @@ namespace {
 // the contact parts of the colliders that take part (include empty: all) at `poses`
 struct ContactSet {
   std::vector<ContactPart> parts;
+  std::span<const uint8_t> include;  // the colliders that take part (empty: all)
   bool anyMoves = false;
 };
 
@@ -189,6 +190,7 @@ ContactSet contactSet(const Model& model, const std::vector<ColliderPose>& poses
   const size_t count = std::min(model.colliders.size(), poses.size());
   const auto takesPart = [&](size_t c) { return include.empty() || (c < include.size() && include[c]); };
   ContactSet set;
+  set.include = include;
   set.parts = contactParts(model, poses, count);
   std::erase_if(set.parts, [&](const ContactPart& part) { return !takesPart(part.owner); });
   for (ContactPart& part : set.parts)
@@ -205,11 +207,7 @@ bool contactParticle(const Model& model, const std::vector<ColliderPose>& poses,
   const float margin = contactMargin(model, p.phase[i]);
   Vec3 xp = p.xPred[i];
   if (bound >= margin) {  // else nothing below can skip the particle
-    float carried = 0.0f;  // how far the colliders carry the start in this step
-    for (size_t k = 0; set.anyMoves && k < set.parts.size(); ++k) {
-      const size_t c = set.parts[k].owner;
-      carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], x) * dt);
-    }
+    const float carried = set.anyMoves ? colliderCarry(model, poses, set.include, x, dt) : 0.0f;  // the start's
     if (bound >= margin + (xp - x).norm() + carried) return false;
   }
   // a push out of one part can put x* into another met before it (a container's wall after its

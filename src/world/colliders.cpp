@@ -329,6 +329,15 @@ float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3
   return speed;
 }
 
+float colliderCarry(const Model& model, const std::vector<ColliderPose>& poses, std::span<const uint8_t> include,
+                    const Vec3& p, float dt) {
+  float carried = 0.0f;
+  for (size_t c = 0; c < model.colliders.size() && c < poses.size(); ++c)
+    if ((include.empty() || (c < include.size() && include[c])) && poses[c].moving())
+      carried = std::max(carried, colliderSpeedBound(model.colliders[c], poses[c], p) * dt);
+  return carried;
+}
+
 namespace {
 
 // the box sdf of boxDistance without its normal, in plain floats for omp simd

@@ -67,6 +67,11 @@ float bodyPartWeights(const Collider& c, const ColliderPose& pose, const Vec3& p
 // a MeshSequence: its fastest vertex on top of the rigid motion)
 float colliderSpeedBound(const Collider& c, const ColliderPose& pose, const Vec3& p);
 
+// how far the moving colliders may carry a surface point near p in dt: the largest colliderSpeedBound
+// times dt over the colliders whose `include` flag is set (empty: all) and that move
+float colliderCarry(const Model& model, const std::vector<ColliderPose>& poses, std::span<const uint8_t> include,
+                    const Vec3& p, float dt);
+
 // a Body collider joining `parts` (sphere, capsule or box colliders, their keys in the body's frame)
 // by smoothMin of radius blendRadius (m); it rests at the identity (one key) and takes the first
 // part's friction and restitution. Throws soak::Error naming `source` on another part shape, no parts
