@@ -45,7 +45,11 @@ struct ClothMaterial {
                                     // its 0.02 m spacing)
   float restDensity = 800.0f;       // kg/m^3 (Table 1)
   float stretchCompliance = 0.0f;   // m/N, XPBD compliance of Eq. 8 (0 = inextensible)
-  float bendCompliance = 1.0e-3f;   // 1/(N m), XPBD compliance of Eq. 9
+  float bendRigidity = 1.3e-3f;     // N m, flexural rigidity B of the fabric: Eq. 9's hinge compliance is
+                                    // (A1 + A2) / (B |e|^2) (cloth_constraints.cpp); the default gives the
+                                    // default arealDensity a 2 cm bending length (B / (arealDensity g))^(1/3)
+  float bendCompliance = -1.0f;     // 1/(N m), XPBD compliance of every Eq. 9 hinge when >= 0, else from
+                                    // bendRigidity
   float damping = 0.0f;             // 1/s, velocity damping of the cloth
   float thickness = 0.01f;          // m, d of Eq. 21 and the self-collision distance
   float friction = 0.3f;            // kinetic Coulomb coefficient against colliders, mixed with theirs

@@ -19,6 +19,10 @@ namespace soak {
 // (ConstraintSchedule). Implicit pieces get none: src/garment builds their springs.
 void buildClothConstraints(Model& model);
 
+// Eq. 9's XPBD compliance of the hinge of edge (a, b) between triangles (a, b, c) and (a, b, d) at rest:
+// material.bendCompliance when >= 0, else (A1 + A2) / (bendRigidity |e|^2) (docs/models.md, Eq. 9)
+float hingeCompliance(const ClothMaterial& mat, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
 // the global stretch step's factored system (cloth_global_stretch.cpp)
 struct GlobalStretch;
 struct GlobalStretchDeleter {

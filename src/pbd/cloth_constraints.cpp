@@ -104,6 +104,16 @@ std::vector<int> trianglePieces(const Model& model) {
 
 }  // namespace
 
+// 1 / k with k = B |e|^2 / (A1 + A2): the hinge energy k theta^2 / 2 is then the plate energy B kappa^2 / 2
+// of a cylindrical bend along the edges of a right-triangle or an equilateral lattice (docs/models.md,
+// Eq. 9; Grinspun et al.'s discrete shells' 3 |e|^2 / (A1 + A2) counts such a bend three times)
+float hingeCompliance(const ClothMaterial& mat, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  if (mat.bendCompliance >= 0.0f) return mat.bendCompliance;
+  const Vec3d e = (b - a).cast<double>();
+  const double areas = 0.5 * (e.cross((c - a).cast<double>()).norm() + e.cross((d - a).cast<double>()).norm());
+  return static_cast<float>(areas / (static_cast<double>(mat.bendRigidity) * e.squaredNorm()));
+}
+
 void buildClothConstraints(Model& model) {
   const int n = model.numCloth;
   const std::vector<int> triPiece = trianglePieces(model);
@@ -132,7 +142,7 @@ void buildClothConstraints(Model& model) {
       const auto& x = model.clothRestPosition;
       bend.ids.push_back(ids);
       bend.restAngle.push_back(bendConstraint(x[ids[0]], x[ids[1]], x[ids[2]], x[ids[3]], 0.0f, grad));
-      bend.compliance.push_back(mat.bendCompliance);
+      bend.compliance.push_back(hingeCompliance(mat, x[ids[0]], x[ids[1]], x[ids[2]], x[ids[3]]));
     }
     s = e;
   }

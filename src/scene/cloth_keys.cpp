@@ -22,7 +22,8 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   const ClothMaterial d;
   ClothMaterial m;
   if (solver == ClothSolver::Implicit) {  // the KES laws, Rayleigh damping and wet friction replace these
-    for (const char* key : {"stretchCompliance", "bendCompliance", "damping", "friction", "staticFriction", "tetherSlack"})
+    for (const char* key : {"stretchCompliance", "bendCompliance", "bendRigidity", "damping", "friction",
+                            "staticFriction", "tetherSlack"})
       if (r.has(key))
         r.log().error(r.pathOf(key), fmt::format("expected no {} on a piece with \"solver\": \"implicit\" (a PBD "
                                                  "key; set the garment section instead, docs/scene-format.md)",
@@ -36,7 +37,12 @@ ClothMaterial readMaterial(ObjectReader r, ClothSolver solver) {
   m.arealDensity = r.has("particleMass") ? 0.0f : r.number("arealDensity", d.arealDensity, Range::positive());
   m.restDensity = r.number("restDensity", d.restDensity, Range::positive());
   m.stretchCompliance = r.number("stretchCompliance", d.stretchCompliance, Range::nonNegative());
-  m.bendCompliance = r.number("bendCompliance", d.bendCompliance, Range::nonNegative());
+  if (r.has("bendCompliance") && r.has("bendRigidity"))
+    r.log().error(r.pathOf("bendRigidity"), "expected either bendCompliance (1/(N m) a hinge) or bendRigidity (N m), "
+                                            "got both");
+  // one of the two sets Eq. 9's stiffness: bendCompliance when given, else bendRigidity (default)
+  m.bendCompliance = r.has("bendCompliance") ? r.number("bendCompliance", std::nullopt, Range::nonNegative()) : -1.0f;
+  m.bendRigidity = r.has("bendCompliance") ? 0.0f : r.number("bendRigidity", d.bendRigidity, Range::positive());
   m.damping = r.number("damping", d.damping, Range::nonNegative());
   m.thickness = r.number("thickness", d.thickness, Range::positive());
   readFriction(r, d.friction, m.friction, m.staticFriction);

@@ -164,6 +164,28 @@ TEST(ClothKeys, ArealDensityGivesTheSameWeightAtAnyResolution) {
   for (float m : table1.model.clothDryMass) EXPECT_FLOAT_EQ(m, 0.0066f);
 }
 
+// material.bendRigidity (default) or bendCompliance sets Eq. 9's hinges: one excludes the other, the
+// rigidity must be positive, an implicit piece refuses both, and the model's hinges get the compliance
+TEST(ClothKeys, BendRigidityOrBendComplianceSetsTheHinges) {
+  const char* sheet = R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]}}]})";
+  const Scene byDefault = fromString(sheet);
+  EXPECT_FLOAT_EQ(byDefault.model.pieces[0].material.bendRigidity, ClothMaterial{}.bendRigidity);
+  EXPECT_LT(byDefault.model.pieces[0].material.bendCompliance, 0.0f);
+  // a 0.1 m lattice: a hinge across a leg has (A1 + A2) / |e|^2 = 1, across a diagonal 1/2
+  const Scene rigid = fromString(sheet, {"cloth.0.material.bendRigidity=0.01"});
+  ASSERT_FALSE(rigid.model.bend.compliance.empty());
+  for (float c : rigid.model.bend.compliance) EXPECT_TRUE(std::abs(c - 100.0f) < 0.01f || std::abs(c - 50.0f) < 0.01f) << c;
+  const Scene given = fromString(sheet, {"cloth.0.material.bendCompliance=0.25"});
+  for (float c : given.model.bend.compliance) EXPECT_FLOAT_EQ(c, 0.25f);
+  EXPECT_HAS(loadError(sheet, {"cloth.0.material.bendCompliance=0.25", "cloth.0.material.bendRigidity=0.01"}),
+             "at cloth[0].material.bendRigidity: expected either bendCompliance (1/(N m) a hinge) or bendRigidity");
+  EXPECT_HAS(loadError(sheet, {"cloth.0.material.bendRigidity=0"}),
+             "at cloth[0].material.bendRigidity: expected a number > 0");
+  EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.2], "resolution": [4, 3]},
+      "solver": "implicit", "material": {"bendRigidity": 0.01}}]})"),
+             "at cloth[0].material.bendRigidity: expected no bendRigidity on a piece with \"solver\": \"implicit\"");
+}
+
 TEST(ClothKeys, ArealDensityAndParticleMassExcludeEachOtherAndEveryVertexNeedsATriangle) {
   EXPECT_HAS(loadError(R"({"cloth": [{"mesh": {"type": "rectangle", "size": [0.3, 0.3], "resolution": [4, 4]},
       "material": {"arealDensity": 0.2, "particleMass": 0.001}}]})"),
