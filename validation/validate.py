@@ -17,6 +17,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import case_bend
 import case_cloth
 import case_wicking
 import numpy as np
@@ -201,10 +202,15 @@ def wicking(work):
     return case_wicking.run(work, save)
 
 
+def cantilever(work):
+    return case_bend.run(work, save)
+
+
 hanging_cloth.__doc__ = case_cloth.__doc__
 wicking.__doc__ = case_wicking.run.__doc__
+cantilever.__doc__ = case_bend.__doc__
 CASES = {"dam_break": dam_break, "rest": rest, "leaks": leaks, "free_fall": free_fall, "budget": budget,
-         "hanging_cloth": hanging_cloth, "wicking": wicking}
+         "hanging_cloth": hanging_cloth, "cantilever": cantilever, "wicking": wicking}
 
 
 def write_report(results):

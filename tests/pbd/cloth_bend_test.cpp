@@ -71,7 +71,7 @@ std::string cantilever() {
              "pin": {"region": {"min": [-1, 0, -1], "max": [0.0001, 1, 1]}}}]})";
 }
 
-// the strip after 8 s (at rest): its tip chord angle in degrees, from the clamp (0, 0.5) to the mean of
+// the strip after 7.2 s (at rest): its tip chord angle in degrees, from the clamp (0, 0.5) to the mean of
 // the tip column
 double cantileverTipAngle(const std::vector<std::string>& overrides) {
   Scene scene = sceneFromJson(cantilever(), overrides);
