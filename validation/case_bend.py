@@ -105,7 +105,7 @@ def run(work, save):
     hx, hy = chain(B, w, L, len(shapes[next(iter(shapes))][0]) - 1)
     (shipped_label, (sx, sy, sv)), (conv_label, (cx, cy, cv)) = shapes.items()
     shipped, converged = tip_angle(sx, sy), tip_angle(cx, cy)
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(9, 4.5))
     ax.plot(ex, ey, "k-", label=f"elastica of B: {lo:.1f} deg")
     ax.plot(soft_x, soft_y, "k--", label=f"elastica of 0.7 B: {hi:.1f} deg")
     ax.plot(hx, hy, "k:", label=f"{len(hx) - 1} hinges of B: {tip_angle(hx, hy):.1f} deg")
@@ -113,7 +113,7 @@ def run(work, save):
     ax.plot(sx, sy, "s-", ms=3, label=f"soak, {shipped_label}: {shipped:.1f} deg")
     ax.set(xlabel="x from the clamp (m)", ylabel="y (m)", aspect="equal",
            title="Cantilever, overhang = 2 x bending length: tip chord angle")
-    ax.legend(fontsize=8, loc="lower left")
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.02, 0.5))
     gap = abs(shipped - converged) / converged
     rows = [("cantilever: converged tip chord angle (16 x 4)", f"between the elastica of B and of 0.7 B ({lo:.1f}-{hi:.1f} deg)",
              f"{converged:.1f} deg (at rest: {cv:.1g} m/s)", lo <= converged <= hi and cv < 0.02),
