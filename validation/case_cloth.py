@@ -9,7 +9,11 @@ back: the sum rises by the weight times that stretch). Counted as springs of the
 (measure()), the stretch takes most of the rise out of the sum; once the release's swing has died
 down (1 s) the sum alone no longer rises. The same sheet with solver.clothGlobalStretch (a global step
 over the edges in each small step, off in the shipped scenes) at 4 small steps and no tethers is held
-to the rest targets and its energy to the never-rises one. run(work, save) -> (rows, plot)."""
+to the rest targets and its energy to the never-rises one. The flat sheet has nothing to break its
+symmetry and stays in its plane, where the bending plays no part; the scenes' sheets fold below the sag
+of their top edge (Fig. 1, 5, 6), so the same sheet started 2.9 degrees out of its plane (it swings in
+and folds) is held to the rest targets too over the last 0.3 s of 6 s, at the shipped small steps and
+at twice as many: its strain is steady from 3 s on while its folds still sway (0.15-0.3 m/s). run(work, save) -> (rows, plot)."""
 import json
 import os
 
@@ -30,6 +34,9 @@ REST_FROM = 1.0       # s: the release's swing has died down to the 1e-4 J/kg sc
 NO_TETHERS = "cloth.0.material.tetherSlack=1000"  # a tether 1000 times its rest path never holds
 # solver.clothGlobalStretch (off in the shipped scenes): a global step over the edges in each of 4 small steps
 GLOBAL = ["solver.clothGlobalStretch=true", "solver.clothSubsteps=4"]
+# the folded runs: the top of the sheet 5 cm out of the plane of its pins' vertical (axisV (0, 1, TILT))
+TILT = 0.05
+TILT_DEGREES = float(np.degrees(np.arctan(TILT)))
 # the water load: every cloth particle holds water at S = 0.35 (Eq. 10 with c = 2e-4 m^3/kg), kept still
 # (no absorption, diffusion, emission or sticking): 60 kg on the 66 kg sheet. A load spread evenly scales
 # every mass alike, which PBD's projections and gravity do not see: this row checks that wet mass leaves
@@ -114,12 +121,25 @@ def wet_scene(work):
     return path
 
 
-def strain_rows(name, m, target_max, target_p99=None):
+def folded_scene(work):
+    """the sheet started TILT out of its vertical plane: it swings into the plane and folds below the sag
+    of its top edge, as the scenes' sheets do (the planar sheet has nothing to break its symmetry and
+    stays flat, where bending plays no part)"""
+    with open(SCENE) as f:
+        scene = json.load(f)
+    scene["cloth"][0]["mesh"]["axisV"] = [0, 1, TILT]
+    path = os.path.join(work, "hanging_cloth_folded.json")
+    with open(path, "w") as f:
+        json.dump(scene, f, indent=1)
+    return path
+
+
+def strain_rows(name, m, target_max, target_p99=None, when="at rest"):
     smax, s99 = at_rest(m)
-    rows = [(f"hanging cloth, {name}: max edge strain at rest", f"<= {100 * target_max:g}%",
+    rows = [(f"hanging cloth, {name}: max edge strain {when}", f"<= {100 * target_max:g}%",
              f"{100 * smax:+.2f}%", smax <= target_max)]
     if target_p99 is not None:
-        rows.append((f"hanging cloth, {name}: p99 edge strain at rest", f"<= {100 * target_p99:g}%",
+        rows.append((f"hanging cloth, {name}: p99 edge strain {when}", f"<= {100 * target_p99:g}%",
                      f"{100 * s99:+.2f}%", s99 <= target_p99))
     return rows
 
@@ -132,12 +152,19 @@ def run(work, save):
             "1 substep": go("substep1", sets=["solver.substeps=1", "solver.clothSubsteps=32"]),
             "reference": go("reference", sets=["solver.clothSubsteps=64", "solver.clothIterations=4", NO_TETHERS]),
             "global step, tethers off": go("global", sets=GLOBAL + [NO_TETHERS])}
+    folded = folded_scene(work)
+    for name, sets in (("folded", ()), ("folded, 32 small steps", ("solver.clothSubsteps=32",))):
+        runs[name] = measure(soakrun.run(folded, os.path.join(work, "cloth_" + name.replace(", ", "_").replace(" ", "_")),
+                                         sets, frames=2 * FRAMES))
     with open(os.path.join(work, "cloth_wet", "stats.jsonl")) as f:
         held = json.loads(f.readline())["waterMass"]["heldInCloth"]
     rows = strain_rows("default settings", runs["rest"], 0.03, 0.01)
     rows += strain_rows(f"{held:.0f} kg of water held", runs["water load"], 0.05)
     rows += strain_rows("tethers off", runs["tethers off"], 0.10)
     rows += strain_rows("1 substep of 32 small steps (the same 0.47 ms small steps)", runs["1 substep"], 0.03, 0.01)
+    last = "over 5.7-6 s"
+    rows += strain_rows(f"folded (started {TILT_DEGREES:.1f} degrees out of its plane)", runs["folded"], 0.03, 0.01, last)
+    rows += strain_rows("folded, 32 small steps (twice the shipped)", runs["folded, 32 small steps"], 0.03, 0.01, last)
     g = runs["global step, tethers off"]
     rows += strain_rows("solver.clothGlobalStretch at 4 small steps, tethers off", g, 0.03, 0.01)
     g_rise = float(np.max(np.diff(g["energy"])))
