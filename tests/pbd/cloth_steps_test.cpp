@@ -171,6 +171,8 @@ TEST(ClothSteps, ClothOnABallKeepsTheVelocityItsPositionsShow) {
   EXPECT_GT(capVelocity(once, Vec3(0, 0.5f, 0)).mismatch, 0.08f);
 }
 
+namespace {
+
 // the sheet on the still ball after 0.99 s at the given small steps and iterations a substep
 Scene drapedOnBall(int smallSteps, int iterations) {
   Scene scene = sceneFromJson(kSheetOnBall, {"solver.clothSubsteps=" + std::to_string(smallSteps),
@@ -178,6 +180,8 @@ Scene drapedOnBall(int smallSteps, int iterations) {
   runSteps(scene, 66);
   return scene;
 }
+
+}  // namespace
 
 // the bending converges (material.bendRigidity, docs/models.md, Eq. 9): the sheet drapes the ball alike at
 // the shipped 16 small steps of one iteration, at 4 iterations and at 4 small steps (mean heights within
