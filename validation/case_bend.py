@@ -77,14 +77,15 @@ def tip_angle(x, y):
     return float(np.degrees(np.arctan2(-y[-1], x[-1])))
 
 
-def centreline(out, frame):
-    """the strip's middle row from the clamp (x = 0) to the tip, relative to the clamp, and its fastest speed"""
+def centreline(out, frame, clamp_y):
+    """the strip's middle row from the clamp (x = 0, y = clamp_y) to the tip, relative to the clamp, and
+    its fastest speed"""
     rest = soakrun.read_vertices(os.path.join(out, "cloth_0000.ply"))
     now = soakrun.read_vertices(os.path.join(out, f"cloth_{frame:04d}.ply"))
     row = (np.abs(rest["z"]) < 1e-4) & (rest["x"] > -1e-4)
     order = np.argsort(rest["x"][row])
     speed = np.sqrt(now["vx"] ** 2 + now["vy"] ** 2 + now["vz"] ** 2).max()
-    return now["x"][row][order], now["y"][row][order] - 0.5, float(speed)
+    return now["x"][row][order], now["y"][row][order] - clamp_y, float(speed)
 
 
 def run(work, save):
@@ -98,7 +99,7 @@ def run(work, save):
     for label, iterations in (("16 small steps x 1 iteration (shipped)", 1), ("16 x 4 (converged)", 4)):
         out = soakrun.run(SCENE, os.path.join(work, f"cantilever_{iterations}"),
                           sets=[f"solver.clothIterations={iterations}"])
-        shapes[label] = centreline(out, frames)
+        shapes[label] = centreline(out, frames, scene["cloth"][0]["mesh"]["center"][1])
     ex, ey = elastica(B, w, L)
     soft_x, soft_y = elastica(0.7 * B, w, L)
     lo, hi = tip_angle(ex, ey), tip_angle(soft_x, soft_y)

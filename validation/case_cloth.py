@@ -111,27 +111,26 @@ def at_rest(m):
     return float(m["max"][-REST_FRAMES:].max()), float(m["p99"][-REST_FRAMES:].max())
 
 
-def wet_scene(work):
+def scene_variant(work, name, change):
+    """validation/hanging_cloth.json with change(scene) applied, written to WORK/hanging_cloth_NAME.json"""
     with open(SCENE) as f:
         scene = json.load(f)
-    scene["wetting"] = WET
-    path = os.path.join(work, "hanging_cloth_wet.json")
+    change(scene)
+    path = os.path.join(work, f"hanging_cloth_{name}.json")
     with open(path, "w") as f:
         json.dump(scene, f, indent=1)
     return path
+
+
+def wet_scene(work):
+    return scene_variant(work, "wet", lambda scene: scene.update(wetting=WET))
 
 
 def folded_scene(work):
     """the sheet started TILT out of its vertical plane: it swings into the plane and folds below the sag
     of its top edge, as the scenes' sheets do (the planar sheet has nothing to break its symmetry and
     stays flat, where bending plays no part)"""
-    with open(SCENE) as f:
-        scene = json.load(f)
-    scene["cloth"][0]["mesh"]["axisV"] = [0, 1, TILT]
-    path = os.path.join(work, "hanging_cloth_folded.json")
-    with open(path, "w") as f:
-        json.dump(scene, f, indent=1)
-    return path
+    return scene_variant(work, "folded", lambda scene: scene["cloth"][0]["mesh"].update(axisV=[0, 1, TILT]))
 
 
 def strain_rows(name, m, target_max, target_p99=None, when="at rest"):

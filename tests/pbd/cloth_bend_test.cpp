@@ -54,29 +54,28 @@ double elasticaTipAngle(double B, double w, double L) {
   return std::atan2(-e.y, e.x) * kRadToDeg;
 }
 
-// a strip 0.4 m wide with 2 m free beyond the clamp (two pinned columns at x <= 0), 0.1 m lattice,
-// Table 1's areal density, bendRigidity for a 1 m bending length c = (B / w)^(1/3): the overhang is 2c,
-// Peirce's 41.5 degrees. The large scale keeps the one-iteration bend solve in its convergent range
-// (docs/models.md, Eq. 9); the lattice has 20 segments along the overhang
-constexpr double kArealDensity = 16.5, kBendingLength = 1.0, kOverhang = 2.0;
-const double kRigidity = kArealDensity * kG * std::pow(kBendingLength, 3.0);
+// validation/cantilever.json: a strip 0.4 m wide with 2 m free beyond the clamp (two pinned columns at
+// x <= 0), 0.1 m lattice, Table 1's areal density, bendRigidity for a 1 m bending length c = (B / w)^(1/3):
+// the overhang is 2c, Peirce's 41.5 degrees. The large scale keeps the one-iteration bend solve in its
+// convergent range (docs/models.md, Eq. 9); the lattice has 20 segments along the overhang
+constexpr const char* kCantilever = "validation/cantilever.json";
+constexpr double kOverhang = 2.0, kClampHeight = 0.5;
 
-std::string cantilever() {
-  return R"({
-  "solver": {"substeps": 2, "clothSubsteps": 16, "clothIterations": 1, "domain": {"min": [-3, -3, -3], "max": [3, 3, 3]}},
-  "cloth": [{"mesh": {"type": "rectangle", "center": [0.95, 0.5, 0], "size": [2.1, 0.4], "resolution": [22, 5],
-                      "axisU": [1, 0, 0], "axisV": [0, 0, 1]},
-             "material": {"arealDensity": 16.5, "bendRigidity": )" +
-         std::to_string(kRigidity) + R"(, "damping": 2, "selfCollision": false},
-             "pin": {"region": {"min": [-1, 0, -1], "max": [0.0001, 1, 1]}}}]})";
+// the scene's B and weight per area w (N/m^2)
+struct Strip {
+  double rigidity, weight;
+};
+Strip strip() {
+  const ClothMaterial& m = sceneFromFile(kCantilever).model.pieces.at(0).material;
+  return {m.bendRigidity, m.arealDensity * kG};
 }
 
-// the strip after 7.2 s (at rest): its tip chord angle in degrees, from the clamp (0, 0.5) to the mean of
-// the tip column
+// the strip after its 7.2 s (at rest): its tip chord angle in degrees, from the clamp (0, 0.5) to the
+// mean of the tip column
 double cantileverTipAngle(const std::vector<std::string>& overrides) {
-  Scene scene = sceneFromJson(cantilever(), overrides);
+  Scene scene = sceneFromFile(kCantilever, overrides);
   const std::vector<Vec3> rest = scene.state.particles.x;
-  runSteps(scene, 480);
+  runSteps(scene, scene.output.frames * scene.output.stepsPerFrame);
   Vec3 tip = Vec3::Zero();
   int count = 0;
   for (int i = 0; i < scene.model.numCloth; ++i)
@@ -85,7 +84,7 @@ double cantileverTipAngle(const std::vector<std::string>& overrides) {
   float fastest = 0.0f;
   for (int i = 0; i < scene.model.numCloth; ++i) fastest = std::max(fastest, scene.state.particles.v[i].norm());
   EXPECT_LT(fastest, 0.02f);  // at rest
-  return std::atan2(0.5 - tip.y(), double(tip.x())) * kRadToDeg;
+  return std::atan2(kClampHeight - tip.y(), double(tip.x())) * kRadToDeg;
 }
 
 }  // namespace
@@ -107,7 +106,9 @@ TEST(ClothBend, HingeComplianceComesFromTheRigidityAndTheRestGeometry) {
 
 // the reference itself: Peirce's cantilever, an overhang of twice the bending length droops 41.5 degrees
 TEST(ClothBend, TheElasticaGivesPeircesAngle) {
-  EXPECT_NEAR(elasticaTipAngle(kRigidity, kArealDensity * kG, kOverhang), 41.5, 0.1);
+  const Strip s = strip();
+  EXPECT_NEAR(std::cbrt(s.rigidity / s.weight), 0.5 * kOverhang, 1e-4);  // the scene's bending length
+  EXPECT_NEAR(elasticaTipAngle(s.rigidity, s.weight, kOverhang), 41.5, 0.1);
 }
 
 // converged (16 small steps of 4 iterations), the strip droops between the elastica of B (41.5 degrees)
@@ -116,14 +117,14 @@ TEST(ClothBend, TheElasticaGivesPeircesAngle) {
 // a bend along the rows (as a chain of 0.87 B). Grinspun's factor 3 in the stiffness gives 22.7 degrees.
 // At the shipped one iteration the strip is within 3.5 degrees of the converged one (50.4)
 TEST(ClothBend, ACantileveredStripDroopsAsTheElasticaOfItsRigidity) {
-  const double w = kArealDensity * kG;
+  const Strip s = strip();
   const double converged = cantileverTipAngle({"solver.clothIterations=4"});
-  EXPECT_GT(converged, elasticaTipAngle(kRigidity, w, kOverhang));
-  EXPECT_LT(converged, elasticaTipAngle(0.7 * kRigidity, w, kOverhang));
+  EXPECT_GT(converged, elasticaTipAngle(s.rigidity, s.weight, kOverhang));
+  EXPECT_LT(converged, elasticaTipAngle(0.7 * s.rigidity, s.weight, kOverhang));
   const double shipped = cantileverTipAngle({});
   EXPECT_NEAR(shipped, converged, 3.5);
   // half the rigidity droops further (the angle follows B, not the solve)
   const double soft = cantileverTipAngle({"solver.clothIterations=4", "cloth.0.material.bendRigidity=" +
-                                                                            std::to_string(0.5 * kRigidity)});
+                                                                            std::to_string(0.5 * s.rigidity)});
   EXPECT_GT(soft, converged + 5.0);
 }
