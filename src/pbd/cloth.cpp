@@ -58,7 +58,7 @@ struct BendSolve {
 
 template <bool Solve>
 void bendKernel(int begin, int end, const int* __restrict I, const float* __restrict rest, const float* __restrict X,
-                float* __restrict Cout, float* __restrict G, int stride, BendSolve solve = {}) {
+                const float* __restrict D, float* __restrict Cout, float* __restrict G, int stride, BendSolve solve = {}) {
   const float* __restrict const compliance = solve.compliance;
   const float* __restrict const w = solve.w;
   float* __restrict const lambda = solve.lambda;
@@ -66,10 +66,15 @@ void bendKernel(int begin, int end, const int* __restrict I, const float* __rest
 #pragma omp simd
   for (int k = begin; k < end; ++k) {
     const int i0 = I[4 * k], i1 = I[4 * k + 1], i2 = I[4 * k + 2], i3 = I[4 * k + 3];
+    // positions X + D, differences taken in the base and in the displacement apart (solveClothFrom)
     const float ax = X[3 * i0], ay = X[3 * i0 + 1], az = X[3 * i0 + 2];
-    const float ex = X[3 * i1] - ax, ey = X[3 * i1 + 1] - ay, ez = X[3 * i1 + 2] - az;  // edge b - a
-    const float cx = X[3 * i2] - ax, cy = X[3 * i2 + 1] - ay, cz = X[3 * i2 + 2] - az;  // c - a
-    const float dx = X[3 * i3] - ax, dy = X[3 * i3 + 1] - ay, dz = X[3 * i3 + 2] - az;  // d - a
+    const float pax = D[3 * i0], pay = D[3 * i0 + 1], paz = D[3 * i0 + 2];
+    const float ex = (X[3 * i1] - ax) + (D[3 * i1] - pax), ey = (X[3 * i1 + 1] - ay) + (D[3 * i1 + 1] - pay),
+                ez = (X[3 * i1 + 2] - az) + (D[3 * i1 + 2] - paz);  // edge b - a
+    const float cx = (X[3 * i2] - ax) + (D[3 * i2] - pax), cy = (X[3 * i2 + 1] - ay) + (D[3 * i2 + 1] - pay),
+                cz = (X[3 * i2 + 2] - az) + (D[3 * i2 + 2] - paz);  // c - a
+    const float dx = (X[3 * i3] - ax) + (D[3 * i3] - pax), dy = (X[3 * i3 + 1] - ay) + (D[3 * i3 + 1] - pay),
+                dz = (X[3 * i3 + 2] - az) + (D[3 * i3 + 2] - paz);  // d - a
     const float len2 = ex * ex + ey * ey + ez * ez;
     // n1 = e x (c - a), n2 = (d - a) x e: 2 * area * unit normal of (a, b, c) and (b, a, d)
     const float n1x = ey * cz - ez * cy, n1y = ez * cx - ex * cz, n1z = ex * cy - ey * cx;
@@ -126,9 +131,10 @@ void bendKernel(int begin, int end, const int* __restrict I, const float* __rest
 // One constraint through bendKernel, the solver's own code (for tests and callers outside the solver).
 float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, float restAngle, Vec3 grad[4]) {
   const float X[12] = {a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()};
+  const float D[12] = {};
   const int I[4] = {0, 1, 2, 3};
   float C, G[12];
-  bendKernel<false>(0, 1, I, &restAngle, X, &C, G, 1);
+  bendKernel<false>(0, 1, I, &restAngle, X, D, &C, G, 1);
   for (int v = 0; v < 4; ++v) grad[v] = Vec3(G[3 * v], G[3 * v + 1], G[3 * v + 2]);
   return C;
 }
@@ -140,12 +146,15 @@ namespace {
 // A colour's constraints share no particle: their moves are computed in a vectorised loop (gathers)
 // into out (component c of constraint k at out[c * stride + k]), then added by the caller (scatters).
 void stretchRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
-                  const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
-                  float* __restrict lambda, float* __restrict out, size_t stride) {
+                  const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict D,
+                  const float* __restrict w, float* __restrict lambda, float* __restrict out, size_t stride) {
 #pragma omp simd
   for (int k = begin; k < end; ++k) {
     const int a = I[2 * k], b = I[2 * k + 1];
-    const float dx = X[3 * a] - X[3 * b], dy = X[3 * a + 1] - X[3 * b + 1], dz = X[3 * a + 2] - X[3 * b + 2];
+    // x_a - x_b of x = X + D: the base's difference plus the displacement's (solveClothFrom)
+    const float dx = (X[3 * a] - X[3 * b]) + (D[3 * a] - D[3 * b]);
+    const float dy = (X[3 * a + 1] - X[3 * b + 1]) + (D[3 * a + 1] - D[3 * b + 1]);
+    const float dz = (X[3 * a + 2] - X[3 * b + 2]) + (D[3 * a + 2] - D[3 * b + 2]);
     const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
     const float z = len >= 1e-12f ? 1.0f : 0.0f;  // coincident particles have no direction to push along
     const float inv = z / std::max(len, 1e-12f);
@@ -175,9 +184,9 @@ void addMoves(int begin, int end, const std::array<int, V>* ids, const float* co
 }
 
 void bendRange(int begin, int end, const int* __restrict I, const float* __restrict rest,
-               const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict w,
-               float* __restrict lambda, float* __restrict out, size_t strideSize) {
-  bendKernel<true>(begin, end, I, rest, X, nullptr, out, static_cast<int>(strideSize), {compliance, invDt2, w, lambda});
+               const float* __restrict compliance, float invDt2, const float* __restrict X, const float* __restrict D,
+               const float* __restrict w, float* __restrict lambda, float* __restrict out, size_t strideSize) {
+  bendKernel<true>(begin, end, I, rest, X, D, nullptr, out, static_cast<int>(strideSize), {compliance, invDt2, w, lambda});
 }
 
 }  // namespace
@@ -187,7 +196,8 @@ void bendRange(int begin, int end, const int* __restrict I, const float* __restr
 // reproduces kappa = 1 (each projection fully satisfies its constraint). Colours are solved in order
 // (Gauss-Seidel between colours); the constraints of one colour share no particle, so they run in parallel
 // and the result does not depend on the thread count.
-void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations) {
+void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
+                    ClothScratch& scratch, float dt, int iterations) {
   const StretchConstraints& st = model.stretch;
   const BendConstraints& bd = model.bend;
   scratch.stretchLambda.assign(st.ids.size(), 0.0f);
@@ -196,8 +206,10 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   scratch.correctionBend.resize(12 * bd.ids.size());
   if (model.numCloth == 0 || dt <= 0.0f) return;
   const float invDt2 = 1.0f / (dt * dt);
-  Vec3* x = p.xPred.data();
-  const float* w = p.invMass.data();
+  const float* X = base[0].data();
+  const float* D = displacement[0].data();
+  Vec3* x = displacement;  // the constraints' moves go to the displacement
+  const float* w = invMass;
   float* stretchLambda = scratch.stretchLambda.data();
   float* bendLambda = scratch.bendLambda.data();
 
@@ -207,13 +219,13 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   float* corrBend = scratch.correctionBend.data();
   const size_t strideStretch = st.ids.size(), strideBend = bd.ids.size();
   const auto stretchBlock = [&](int begin, int end) {
-    stretchRange(begin, end, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, x[0].data(), w,
+    stretchRange(begin, end, st.ids[0].data(), st.restLength.data(), st.compliance.data(), invDt2, X, D, w,
                  stretchLambda, corrStretch, strideStretch);
     addMoves(begin, end, st.ids.data(), corrStretch, strideStretch, x);
   };
   const auto bendBlock = [&](int begin, int end) {
-    bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, x[0].data(), w,
-              bendLambda, corrBend, strideBend);
+    bendRange(begin, end, bd.ids[0].data(), bd.restAngle.data(), bd.compliance.data(), invDt2, X, D, w, bendLambda,
+              corrBend, strideBend);
     addMoves(begin, end, bd.ids.data(), corrBend, strideBend, x);
   };
   // one group: its stretch constraints colour by colour, then its bend constraints
@@ -245,6 +257,19 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
       solveGroup(2 * slabs - 1);
     }
   }
+}
+
+// the displacement x* - x taken out of x*, solved, and put back: the particles the constraints move
+// (free PBD cloth) get x + displacement; the rest keep their x* as it is
+void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations) {
+  const int n = model.numCloth;
+  scratch.displacement.resize(static_cast<size_t>(n));
+  Vec3* d = scratch.displacement.data();
+  parallelFor(n, [&](int64_t i) { d[i] = p.xPred[i] - p.x[i]; });
+  solveClothFrom(model, p.x.data(), d, p.invMass.data(), scratch, dt, iterations);
+  parallelFor(n, [&](int64_t i) {
+    if (movesWithConstraints(model, p, i)) p.xPred[i] = p.x[i] + d[i];
+  });
 }
 
 }  // namespace soak

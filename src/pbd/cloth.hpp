@@ -40,7 +40,8 @@ struct ClothScratch {
   std::vector<int> pairCount, pairs;  // CSR: particle i's self-collision pairs are pairs[pairCount[i], pairCount[i + 1])
   std::vector<int> pairOwners;        // the particles with at least one such pair, in order
   std::vector<float> speed;           // m/s, |v| of each cloth particle at the substep's start (findSelfCollisionPairs)
-  std::vector<Vec3> stepPosition, stepVelocity;  // m, m/s: a cloth particle's at the start of a small step
+  std::vector<Vec3> displacement;     // m, x* - x of each cloth particle while the constraints solve (solveClothFrom)
+  std::vector<Vec3> stepDisplacement, stepVelocity;  // m, m/s: a cloth particle's x* - x and v at a small step's start
   std::vector<Vec3> velocityOffset;  // m/s: the last small step's velocity minus (x* - x)/h (stepCloth)
   std::vector<Vec3> stepStart;       // m, x* before a small step's prediction: where its collider contact starts
   std::vector<float> colliderBound;  // m, a lower bound of each cloth particle's distance to the colliders
@@ -63,8 +64,22 @@ float stretchConstraint(const Vec3& x1, const Vec3& x2, float restLength, Vec3& 
 // writes the gradients wrt a, b, c, d
 float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, float restAngle, Vec3 grad[4]);
 
-// solves the cloth constraints for `iterations` iterations on p.xPred (XPBD, multipliers reset
-// here once per substep)
+// solves the cloth constraints for `iterations` iterations on x* = base + displacement, moving the
+// displacement (XPBD, multipliers reset here once per substep). Each constraint takes the difference of
+// two positions as the difference of their bases plus that of their displacements, so a move far
+// smaller than a float's resolution at |x| (1.2e-7 m at 1 m) is kept: a small step's moves are (docs/models.md,
+// "Single precision and the small steps")
+void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
+                    ClothScratch& scratch, float dt, int iterations);
+
+// a cloth particle the PBD constraints move: free (invMass > 0), neither pinned nor in an implicit piece
+inline bool movesWithConstraints(const Model& model, const Particles& p, int64_t i) {
+  const bool pinned = i < static_cast<int64_t>(model.clothPinned.size()) && model.clothPinned[static_cast<size_t>(i)];
+  return p.invMass[static_cast<size_t>(i)] > 0.0f && !pinned && !model.implicitCloth(i);
+}
+
+// solveClothFrom on p.xPred, the displacement from p.x: x* = x + displacement after it for the
+// particles it moves (movesWithConstraints), the rest keep their x*
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations);
 
 // the PBD cloth's substep of h: model.solver.clothSubsteps small steps of h/clothSubsteps, each a

@@ -66,8 +66,6 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
   const float hs = h / static_cast<float>(steps);
   const Vec3 g = model.solver.gravity;
   const auto moves = [&](int64_t i) { return !model.clothPinned[i] && !model.clothImplicit[i]; };
-  scratch.stepPosition.resize(n);
-  scratch.stepVelocity.resize(n);
   // the colliders in each small step too: met only after them, a resting cloth's small steps slid and
   // sank freely and the substep's friction took the slip back from x*, leaving the last small step's
   // velocity stored in the contact (docs/models.md, "Colliders")
@@ -76,25 +74,53 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     scratch.stepStart.resize(n);
     findColliderCandidates(model, *colliders, p, h, scratch);
   }
-  Vec3* y = scratch.stepPosition.data();
+  // the small steps move d = x* - x from the substep's start x, not x* itself: a small step's move
+  // (g h_s^2 = 1.7e-7 m at 64 small steps of 1/120 s) is about a float's resolution at 1 m, and the
+  // velocities taken from x* so rounded heated a resting cloth (docs/models.md, "Single precision and
+  // the small steps"); x* = x + d is rounded only where the tethers, the global step, the
+  // self-collision and the colliders read it, and their moves are taken back into d exactly
+  scratch.displacement.resize(n);
+  scratch.stepDisplacement.resize(n);
+  scratch.stepVelocity.resize(n);
+  Vec3* d = scratch.displacement.data();
+  Vec3* y = scratch.stepDisplacement.data();
   Vec3* u = scratch.stepVelocity.data();
-  // the substep's start: x and the velocity before predictPositions added h g
+  const Vec3* x = p.x.data();
+  // the substep's start: d = 0 and the velocity before predictPositions added h g (a particle that
+  // does not move keeps its x*)
   parallelFor(n, [&](int64_t i) {
-    y[i] = p.x[i];
+    d[i] = moves(i) ? Vec3::Zero() : Vec3(p.xPred[i] - x[i]);
+    y[i] = d[i];
     u[i] = moves(i) ? Vec3(p.v[i] - h * g) : Vec3::Zero();
   });
+  const auto putOut = [&] {  // x* = x + d
+    parallelFor(n, [&](int64_t i) {
+      if (moves(i)) p.xPred[i] = x[i] + d[i];
+    });
+  };
+  const auto takeBack = [&] {  // d takes what moved x* since putOut
+    parallelFor(n, [&](int64_t i) {
+      const Vec3 put = x[i] + d[i];
+      if (moves(i) && p.xPred[i] != put) d[i] += p.xPred[i] - put;
+    });
+  };
   // y holds each small step's prediction: the velocity changes by the constraints' move over h_s, so a
-  // particle they leave alone keeps v + t g exactly (from x* - x, rounding in |x| / h_s would drift)
+  // particle they leave alone keeps v + t g exactly
   for (int s = 0; s < steps; ++s) {
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
       u[i] += hs * g;
-      if (contact) scratch.stepStart[i] = y[i];
-      p.xPred[i] = y[i] + hs * u[i];
-      y[i] = p.xPred[i];
+      if (contact) scratch.stepStart[i] = x[i] + y[i];
+      d[i] = y[i] + hs * u[i];
+      y[i] = d[i];
     });
-    solveTethers(model, p);
-    solveCloth(model, p, scratch, hs, iterations);
+    if (!model.tethers.anchor.empty()) {
+      putOut();
+      solveTethers(model, p);
+      takeBack();
+    }
+    solveClothFrom(model, x, d, p.invMass.data(), scratch, hs, iterations);
+    putOut();
     globalStretchStep(model, p, scratch);
     clock.lap();
     collideSelfCollisionPairs(model, p, scratch);
@@ -103,10 +129,11 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
       scratch.colliderPutBack += projectColliders(model, colliders->poses[s], p, scratch.colliderCandidates,
                                                   scratch.stepStart.data(), colliders->include, hs,
                                                   static_cast<float>(steps - 1 - s) * hs);
+    takeBack();
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
-      u[i] += (p.xPred[i] - y[i]) / hs;
-      y[i] = p.xPred[i];
+      u[i] += (d[i] - y[i]) / hs;
+      y[i] = d[i];
     });
   }
   // updateVelocities takes v = (x* - x)/h, the mean over the substep; the offset turns it into the last
