@@ -77,8 +77,8 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
   // the small steps move d = x* - x from the substep's start x, not x* itself: a small step's move
   // (g h_s^2 = 1.7e-7 m at 64 small steps of 1/120 s) is about a float's resolution at 1 m, and the
   // velocities taken from x* so rounded heated a resting cloth (docs/models.md, "Single precision and
-  // the small steps"); x* = x + d is rounded only where the tethers, the global step, the
-  // self-collision and the colliders read it, and their moves are taken back into d exactly
+  // the small steps"); the tethers move d too, and x* = x + d is rounded only where the global step,
+  // the self-collision and the colliders read it, their moves taken back into d exactly
   scratch.displacement.resize(n);
   scratch.stepDisplacement.resize(n);
   scratch.stepVelocity.resize(n);
@@ -98,11 +98,9 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
       if (moves(i)) p.xPred[i] = x[i] + d[i];
     });
   };
-  const auto takeBack = [&] {  // d takes what moved x* since putOut
-    parallelFor(n, [&](int64_t i) {
-      const Vec3 put = x[i] + d[i];
-      if (moves(i) && p.xPred[i] != put) d[i] += p.xPred[i] - put;
-    });
+  const auto takeBack = [&](int64_t i) {  // d takes what moved x* since putOut
+    const Vec3 put = x[i] + d[i];
+    if (p.xPred[i] != put) d[i] += p.xPred[i] - put;
   };
   // y holds each small step's prediction: the velocity changes by the constraints' move over h_s, so a
   // particle they leave alone keeps v + t g exactly
@@ -114,11 +112,7 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
       d[i] = y[i] + hs * u[i];
       y[i] = d[i];
     });
-    if (!model.tethers.anchor.empty()) {
-      putOut();
-      solveTethers(model, p);
-      takeBack();
-    }
+    solveTethersFrom(model, x, d);
     solveClothFrom(model, x, d, p.invMass.data(), scratch, hs, iterations);
     putOut();
     globalStretchStep(model, p, scratch);
@@ -129,9 +123,9 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
       scratch.colliderPutBack += projectColliders(model, colliders->poses[s], p, scratch.colliderCandidates,
                                                   scratch.stepStart.data(), colliders->include, hs,
                                                   static_cast<float>(steps - 1 - s) * hs);
-    takeBack();
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
+      takeBack(i);
       u[i] += (d[i] - y[i]) / hs;
       y[i] = d[i];
     });

@@ -80,14 +80,37 @@ void buildTethers(Model& model, int maxAnchors) {
   }
 }
 
+namespace {
+
+// the anchor-to-particle vector d brought back onto the sphere |d| = length when outside it
+bool pullIn(Vec3& d, float length) {
+  const float len = d.norm();
+  if (len <= length) return false;
+  d *= length / len;
+  return true;
+}
+
+}  // namespace
+
 void solveTethers(const Model& model, Particles& p) {
   const Tethers& t = model.tethers;
   if (t.anchor.empty()) return;
   parallelFor(model.numCloth, [&](int64_t i) {
     for (int k = t.start[i]; k < t.start[i + 1]; ++k) {
-      const Vec3 d = p.xPred[i] - p.xPred[t.anchor[k]];
-      const float len = d.norm();
-      if (len > t.length[k]) p.xPred[i] = p.xPred[t.anchor[k]] + d * (t.length[k] / len);
+      Vec3 d = p.xPred[i] - p.xPred[t.anchor[k]];
+      if (pullIn(d, t.length[k])) p.xPred[i] = p.xPred[t.anchor[k]] + d;
+    }
+  });
+}
+
+void solveTethersFrom(const Model& model, const Vec3* base, Vec3* displacement) {
+  const Tethers& t = model.tethers;
+  if (t.anchor.empty()) return;
+  parallelFor(model.numCloth, [&](int64_t i) {
+    for (int k = t.start[i]; k < t.start[i + 1]; ++k) {
+      const int a = t.anchor[k];
+      Vec3 d = (base[i] - base[a]) + (displacement[i] - displacement[a]);
+      if (pullIn(d, t.length[k])) displacement[i] = (base[a] - base[i]) + displacement[a] + d;
     }
   });
 }

@@ -14,4 +14,7 @@ void buildTethers(Model& model, int maxAnchors = 4);
 // are pinned, so only the free particle moves; gather style)
 void solveTethers(const Model& model, Particles& p);
 
+// the same on x* = base + displacement, moving the displacement (the small steps, solveClothFrom)
+void solveTethersFrom(const Model& model, const Vec3* base, Vec3* displacement);
+
 }  // namespace soak

@@ -82,3 +82,29 @@ TEST(Tethers, SheetPinnedAtItsCornersHangsWithoutTurnedOverTriangles) {
   for (int i = 0; i < scene.model.numCloth; ++i) lowest = std::min(lowest, p.x[i].y());
   EXPECT_LT(lowest, 0.99f);  // it did hang
 }
+
+// the small steps' form (solveTethersFrom, on x* = base + displacement) brings each particle onto its
+// tether's sphere as solveTethers does on x*, and moves only the displacement
+TEST(Tethers, OnADisplacementTheyPullAsOnThePositions) {
+  const Scene scene = sceneFromJson(cornerSheet(21, 0.0f));
+  const Model& model = scene.model;
+  const int n = model.numCloth;
+  std::vector<Vec3> base(static_cast<size_t>(n)), moved(static_cast<size_t>(n));
+  Particles p = scene.state.particles;
+  for (int i = 0; i < n; ++i) {
+    base[i] = model.clothRestPosition[i];
+    // every free particle pushed 5 cm away from the sheet's centre, outward and down: past its tethers
+    const bool pinned = model.clothPinned[i] != 0;
+    moved[i] = pinned ? Vec3::Zero() : Vec3(0.05f * base[i].x(), -0.05f, 0.05f * base[i].z());
+    p.xPred[i] = base[i] + moved[i];
+  }
+  solveTethers(model, p);
+  std::vector<Vec3> d = moved;
+  solveTethersFrom(model, base.data(), d.data());
+  int pulled = 0;
+  for (int i = 0; i < n; ++i) {
+    EXPECT_LT((base[i] + d[i] - p.xPred[i]).norm(), 1e-6f) << i;
+    pulled += (d[i] - moved[i]).norm() > 1e-4f ? 1 : 0;
+  }
+  EXPECT_GT(pulled, n / 2);  // the push was past most tethers
+}
