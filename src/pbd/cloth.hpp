@@ -66,9 +66,9 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 
 // solves the cloth constraints for `iterations` iterations on x* = base + displacement, moving the
 // displacement (XPBD, multipliers reset here once per substep). Each constraint takes the difference of
-// two positions as the difference of their bases plus that of their displacements, so a move far
-// smaller than a float's resolution at |x| (1.2e-7 m at 1 m) is kept: a small step's moves are (docs/models.md,
-// "Single precision and the small steps")
+// two positions as the difference of their bases plus that of their displacements, so moves far below a
+// float's resolution at |x| (1.2e-7 m at 1 m), as a small step's are, are kept (docs/models.md, "Single
+// precision and the small steps")
 void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                     ClothScratch& scratch, float dt, int iterations);
 
