@@ -268,7 +268,7 @@ void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float d
   parallelFor(n, [&](int64_t i) { d[i] = p.xPred[i] - p.x[i]; });
   solveClothFrom(model, p.x.data(), d, p.invMass.data(), scratch, dt, iterations);
   parallelFor(n, [&](int64_t i) {
-    if (movesWithConstraints(model, p, i)) p.xPred[i] = p.x[i] + d[i];
+    if (pbdClothMoves(model, i)) p.xPred[i] = p.x[i] + d[i];
   });
 }
 

@@ -72,14 +72,14 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                     ClothScratch& scratch, float dt, int iterations);
 
-// a cloth particle the PBD constraints move: free (invMass > 0), neither pinned nor in an implicit piece
-inline bool movesWithConstraints(const Model& model, const Particles& p, int64_t i) {
+// a cloth particle the PBD cloth moves: neither pinned nor in an implicit piece
+inline bool pbdClothMoves(const Model& model, int64_t i) {
   const bool pinned = i < static_cast<int64_t>(model.clothPinned.size()) && model.clothPinned[static_cast<size_t>(i)];
-  return p.invMass[static_cast<size_t>(i)] > 0.0f && !pinned && !model.implicitCloth(i);
+  return !pinned && !model.implicitCloth(i);
 }
 
 // solveClothFrom on p.xPred, the displacement from p.x: x* = x + displacement after it for the
-// particles it moves (movesWithConstraints), the rest keep their x*
+// particles the PBD cloth moves (pbdClothMoves), the rest keep their x*
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations);
 
 // the PBD cloth's substep of h: model.solver.clothSubsteps small steps of h/clothSubsteps, each a

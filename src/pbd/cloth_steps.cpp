@@ -36,36 +36,22 @@ void findColliderCandidates(const Model& model, const SmallStepColliders& collid
     }
 }
 
-}  // namespace
 
-void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h,
-               const SmallStepColliders* colliders) {
+// stepCloth's clothSubsteps small steps of the substep h, each a prediction from the last, the tethers,
+// the constraints, the global step, the self-collision pairs and the colliders; leaves x* at the last
+// small step's end and each particle's velocity there in scratch.stepVelocity.
+// The small steps move d = x* - x from the substep's start x, not x* itself: a small step's move
+// (g h_s^2 = 1.7e-7 m at 64 small steps of 1/120 s) is about a float's resolution at 1 m, and the
+// velocities taken from x* so rounded heated a resting cloth (docs/models.md, "Single precision and
+// the small steps"); the tethers move d too, and x* = x + d is rounded only where the global step,
+// the self-collision and the colliders read it, their moves taken back into d exactly
+void smallSteps(const Model& model, Particles& p, ClothScratch& scratch, float h, const SmallStepColliders* colliders,
+                LapClock& clock) {
   const int n = model.numCloth;
-  scratch.colliderPutBack = 0;
   const int steps = std::max(1, model.solver.clothSubsteps);
-  const int iterations = model.solver.clothIterations;
-  scratch.selfCollisionMs = 0.0;
-  LapClock clock;
-  if (steps == 1 || n == 0 || h <= 0.0f) {
-    scratch.velocityOffset.clear();  // v = (x* - x)/h as it is
-    solveTethers(model, p);  // long range attachments first, the iterations smooth what they moved
-    solveCloth(model, p, scratch, h, iterations);
-    globalStretchStep(model, p, scratch);
-    clock.lap();
-    clothSelfCollision(model, p, neighbors, scratch);
-    scratch.selfCollisionMs += clock.lap();
-    return;
-  }
-  scratch.velocityOffset.assign(static_cast<size_t>(n), Vec3::Zero());
-  // the self-collision in each small step, with its constraints: pushed apart only once a substep, a
-  // crumpled fold's layers were pulled back by the small steps' constraints at 1/h_s and jittered at
-  // metres a second (docs/models.md, "Cloth self-collision in the small steps")
-  clock.lap();
-  findSelfCollisionPairs(model, p, neighbors, h, scratch);
-  scratch.selfCollisionMs += clock.lap();
   const float hs = h / static_cast<float>(steps);
   const Vec3 g = model.solver.gravity;
-  const auto moves = [&](int64_t i) { return !model.clothPinned[i] && !model.clothImplicit[i]; };
+  const auto moves = [&](int64_t i) { return pbdClothMoves(model, i); };
   // the colliders in each small step too: met only after them, a resting cloth's small steps slid and
   // sank freely and the substep's friction took the slip back from x*, leaving the last small step's
   // velocity stored in the contact (docs/models.md, "Colliders")
@@ -74,11 +60,6 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     scratch.stepStart.resize(n);
     findColliderCandidates(model, *colliders, p, h, scratch);
   }
-  // the small steps move d = x* - x from the substep's start x, not x* itself: a small step's move
-  // (g h_s^2 = 1.7e-7 m at 64 small steps of 1/120 s) is about a float's resolution at 1 m, and the
-  // velocities taken from x* so rounded heated a resting cloth (docs/models.md, "Single precision and
-  // the small steps"); the tethers move d too, and x* = x + d is rounded only where the global step,
-  // the self-collision and the colliders read it, their moves taken back into d exactly
   scratch.displacement.resize(n);
   scratch.stepDisplacement.resize(n);
   scratch.stepVelocity.resize(n);
@@ -93,15 +74,6 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
     y[i] = d[i];
     u[i] = moves(i) ? Vec3(p.v[i] - h * g) : Vec3::Zero();
   });
-  const auto putOut = [&] {  // x* = x + d
-    parallelFor(n, [&](int64_t i) {
-      if (moves(i)) p.xPred[i] = x[i] + d[i];
-    });
-  };
-  const auto takeBack = [&](int64_t i) {  // d takes what moved x* since putOut
-    const Vec3 put = x[i] + d[i];
-    if (p.xPred[i] != put) d[i] += p.xPred[i] - put;
-  };
   // y holds each small step's prediction: the velocity changes by the constraints' move over h_s, so a
   // particle they leave alone keeps v + t g exactly
   for (int s = 0; s < steps; ++s) {
@@ -113,8 +85,10 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
       y[i] = d[i];
     });
     solveTethersFrom(model, x, d);
-    solveClothFrom(model, x, d, p.invMass.data(), scratch, hs, iterations);
-    putOut();
+    solveClothFrom(model, x, d, p.invMass.data(), scratch, hs, model.solver.clothIterations);
+    parallelFor(n, [&](int64_t i) {  // x* = x + d for the stages that read x*
+      if (moves(i)) p.xPred[i] = x[i] + d[i];
+    });
     globalStretchStep(model, p, scratch);
     clock.lap();
     collideSelfCollisionPairs(model, p, scratch);
@@ -125,16 +99,47 @@ void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors,
                                                   static_cast<float>(steps - 1 - s) * hs);
     parallelFor(n, [&](int64_t i) {
       if (!moves(i)) return;
-      takeBack(i);
+      const Vec3 put = x[i] + d[i];  // d takes what those stages moved x* by, exactly
+      if (p.xPred[i] != put) d[i] += p.xPred[i] - put;
       u[i] += (d[i] - y[i]) / hs;
       y[i] = d[i];
     });
   }
+}
+
+}  // namespace
+
+void stepCloth(const Model& model, Particles& p, const NeighborLists& neighbors, ClothScratch& scratch, float h,
+               const SmallStepColliders* colliders) {
+  const int n = model.numCloth;
+  scratch.colliderPutBack = 0;
+  const int steps = std::max(1, model.solver.clothSubsteps);
+  scratch.selfCollisionMs = 0.0;
+  LapClock clock;
+  if (steps == 1 || n == 0 || h <= 0.0f) {
+    scratch.velocityOffset.clear();  // v = (x* - x)/h as it is
+    solveTethers(model, p);  // long range attachments first, the iterations smooth what they moved
+    solveCloth(model, p, scratch, h, model.solver.clothIterations);
+    globalStretchStep(model, p, scratch);
+    clock.lap();
+    clothSelfCollision(model, p, neighbors, scratch);
+    scratch.selfCollisionMs += clock.lap();
+    return;
+  }
+  scratch.velocityOffset.assign(static_cast<size_t>(n), Vec3::Zero());
+  // the self-collision in each small step, with its constraints: pushed apart only once a substep, a
+  // crumpled fold's layers were pulled back by the small steps' constraints at 1/h_s and jittered at
+  // metres a second (docs/models.md, "Cloth self-collision in the small steps")
+  clock.lap();
+  findSelfCollisionPairs(model, p, neighbors, h, scratch);
+  scratch.selfCollisionMs += clock.lap();
+  smallSteps(model, p, scratch, h, colliders, clock);
   // updateVelocities takes v = (x* - x)/h, the mean over the substep; the offset turns it into the last
   // small step's velocity plus what the later stages (collisions, coupling) add to x*, over h
+  const Vec3* u = scratch.stepVelocity.data();
   Vec3* offset = scratch.velocityOffset.data();
   parallelFor(n, [&](int64_t i) {
-    if (moves(i)) offset[i] = u[i] - (p.xPred[i] - p.x[i]) / h;
+    if (pbdClothMoves(model, i)) offset[i] = u[i] - (p.xPred[i] - p.x[i]) / h;
   });
 }
 
