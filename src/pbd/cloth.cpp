@@ -259,13 +259,14 @@ void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, co
   }
 }
 
-// the displacement x* - x taken out of x*, solved, and put back: the particles the constraints move
+// the displacement x* - x taken out of x*, solved (the coarse levels first), and put back: the particles the constraints move
 // (free PBD cloth) get x + displacement; the rest keep their x* as it is
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations) {
   const int n = model.numCloth;
   scratch.displacement.resize(static_cast<size_t>(n));
   Vec3* d = scratch.displacement.data();
   parallelFor(n, [&](int64_t i) { d[i] = p.xPred[i] - p.x[i]; });
+  solveHierarchyFrom(model, p.x.data(), d, p.invMass.data(), scratch);
   solveClothFrom(model, p.x.data(), d, p.invMass.data(), scratch, dt, iterations);
   parallelFor(n, [&](int64_t i) {
     if (pbdClothMoves(model, i)) p.xPred[i] = p.x[i] + d[i];

@@ -29,6 +29,12 @@ struct GlobalStretchDeleter {
   void operator()(GlobalStretch* g) const;
 };
 
+// the coarse levels of solver.clothHierarchy (cloth_hierarchy.cpp)
+struct ClothHierarchy;
+struct ClothHierarchyDeleter {
+  void operator()(ClothHierarchy* h) const;
+};
+
 // scratch for the cloth solver (XPBD multipliers)
 struct ClothScratch {
   std::vector<float> stretchLambda, bendLambda;
@@ -48,6 +54,7 @@ struct ClothScratch {
   std::vector<int> colliderCandidates;  // the cloth particles that may meet a collider in the substep
   uint64_t colliderPutBack = 0;      // the small steps' collider put-backs of the last stepCloth
   std::unique_ptr<GlobalStretch, GlobalStretchDeleter> globalStretch;  // built at the first globalStretchStep
+  std::unique_ptr<ClothHierarchy, ClothHierarchyDeleter> hierarchy;    // built at the first solveHierarchyFrom
 };
 
 // the colliders the PBD cloth meets in each of its small steps (step.cpp fills it: smallStepColliders)
@@ -72,14 +79,24 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                     ClothScratch& scratch, float dt, int iterations);
 
+// solver.clothHierarchy coarse levels (Müller 2008, hierarchical PBD) on x* = base + displacement: each
+// level a maximal independent set of the finer one's particles (the pins always in), joined where they
+// are neighbours or share one, its edges at their rest-shape distances; coarsest first, one Gauss-Seidel
+// pass over a level's edges that are stretched (never pushing, so the finer mesh folds freely), its
+// members' moves interpolated to the finer level's other particles (inverse rest distance weights),
+// masses lumped the same way so the moves keep momentum. Built at the first call; moves only free PBD
+// cloth (docs/models.md, Eq. 8, "The coarse levels")
+void solveHierarchyFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
+                        ClothScratch& scratch);
+
 // a cloth particle the PBD cloth moves: neither pinned nor in an implicit piece
 inline bool pbdClothMoves(const Model& model, int64_t i) {
   const bool pinned = i < static_cast<int64_t>(model.clothPinned.size()) && model.clothPinned[static_cast<size_t>(i)];
   return !pinned && !model.implicitCloth(i);
 }
 
-// solveClothFrom on p.xPred, the displacement from p.x: x* = x + displacement after it for the
-// particles the PBD cloth moves (pbdClothMoves), the rest keep their x*
+// solveHierarchyFrom and solveClothFrom on p.xPred, the displacement from p.x: x* = x + displacement
+// after them for the particles the PBD cloth moves (pbdClothMoves), the rest keep their x*
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations);
 
 // the PBD cloth's substep of h: model.solver.clothSubsteps small steps of h/clothSubsteps, each a

@@ -38,8 +38,8 @@ void findColliderCandidates(const Model& model, const SmallStepColliders& collid
 
 
 // stepCloth's clothSubsteps small steps of the substep h, each a prediction from the last, the tethers,
-// the constraints, the global step, the self-collision pairs and the colliders; leaves x* at the last
-// small step's end and each particle's velocity there in scratch.stepVelocity.
+// the coarse levels, the constraints, the global step, the self-collision pairs and the colliders;
+// leaves x* at the last small step's end and each particle's velocity there in scratch.stepVelocity.
 // The small steps move d = x* - x from the substep's start x, not x* itself: a small step's move
 // (g h_s^2 = 1.7e-7 m at 64 small steps of 1/120 s) is about a float's resolution at 1 m, and the
 // velocities taken from x* so rounded heated a resting cloth (docs/models.md, "Single precision and
@@ -85,6 +85,7 @@ void smallSteps(const Model& model, Particles& p, ClothScratch& scratch, float h
       y[i] = d[i];
     });
     solveTethersFrom(model, x, d);
+    solveHierarchyFrom(model, x, d, p.invMass.data(), scratch);
     solveClothFrom(model, x, d, p.invMass.data(), scratch, hs, model.solver.clothIterations);
     parallelFor(n, [&](int64_t i) {  // x* = x + d for the stages that read x*
       if (moves(i)) p.xPred[i] = x[i] + d[i];

@@ -106,6 +106,7 @@ void readSolver(ObjectReader r, SolverParams& s, float& maxMemoryGB) {
   s.clothSubsteps = r.integer("clothSubsteps", d.clothSubsteps, loops);
   s.clothIterations = r.integer("clothIterations", d.clothIterations, loops0);
   s.clothCollidersInSmallSteps = r.boolean("clothCollidersInSmallSteps", d.clothCollidersInSmallSteps);
+  s.clothHierarchy = r.integer("clothHierarchy", d.clothHierarchy, Range::between(0, 16));
   s.clothGlobalStretch = r.boolean("clothGlobalStretch", d.clothGlobalStretch);
   s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, loops0);
   s.gravity = r.vec3("gravity", d.gravity);
