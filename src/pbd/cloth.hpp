@@ -79,13 +79,14 @@ float bendConstraint(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
 void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                     ClothScratch& scratch, float dt, int iterations);
 
-// solver.clothHierarchy coarse levels (Müller 2008, hierarchical PBD) on x* = base + displacement: each
-// level a maximal independent set of the finer one's particles (the pins always in), joined where they
-// are neighbours or share one, its edges at their rest-shape distances; coarsest first, one Gauss-Seidel
-// pass over a level's edges that are stretched (never pushing, so the finer mesh folds freely), its
-// members' moves interpolated to the finer level's other particles (inverse rest distance weights),
-// masses lumped the same way so the moves keep momentum. Built at the first call; moves only free PBD
-// cloth (docs/models.md, Eq. 8, "The coarse levels")
+// solver.clothHierarchy coarse levels (after Müller 2008, hierarchical PBD) on x* = base + displacement:
+// each level a maximal independent set of the finer one's particles (the pins always in); each of its
+// particles stands for the weighted mean of a cluster (itself and the finer particles next to it), and
+// clusters whose particles are neighbours or share one below are joined by a constraint |centre_a -
+// centre_b| <= its rest value, projected as a PBD constraint over the clusters' particles (mass
+// weighted, momentum kept). Coarsest first, one Gauss-Seidel pass a level, only the stretched edges
+// (never pushing, so the cloth folds freely). Built at the first call; moves only free PBD cloth
+// (docs/models.md, Eq. 8, "The coarse levels")
 void solveHierarchyFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                         ClothScratch& scratch);
 

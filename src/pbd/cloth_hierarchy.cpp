@@ -1,8 +1,8 @@
-// The PBD cloth's coarse levels (solver.clothHierarchy; Müller 2008, "Hierarchical position based
-// dynamics"): before each small step's constraint iterations, the sheet's particles are brought within
-// the distances of a few coarser meshes, coarsest first, and each level's moves are interpolated to the
-// particles of the level below it, so that the load a pin holds reaches the whole sheet within one small
-// step instead of a few edges an iteration (docs/models.md, Eq. 8, "The coarse levels").
+// The PBD cloth's coarse levels (solver.clothHierarchy; after Müller 2008, "Hierarchical position based
+// dynamics"): before each small step's constraint iterations, the distances between the centres of a few
+// coarser meshes' clusters of particles are brought within their rest values, coarsest first, so that the
+// load a pin holds reaches the whole sheet within one small step instead of a few edges an iteration
+// (docs/models.md, Eq. 8, "The coarse levels").
 #include "pbd/cloth.hpp"
 
 #include <algorithm>
@@ -13,30 +13,26 @@
 
 namespace soak {
 
-// one coarse level: a subset of the next finer level's particles (a maximal independent set of its
-// graph, the pins always in), joined where they are neighbours or share a neighbour there
+// each level's coarse edges, each a constraint C = |sum_i c_i x_i| - r over the particles of its two
+// clusters (c_i = phi_a,i - phi_b,i, so sum_i c_i = 0)
 struct ClothHierarchy {
   struct Level {
-    std::vector<int> members;                 // cloth particle ids
-    std::vector<std::array<int, 2>> edges;    // indices into members
-    std::vector<float> rest;                  // m, the edges' distances on the rest shape
-    // the finer level's particles that are not members, each moved by its parents' moves, weighted
-    std::vector<int> children;                // cloth particle ids
-    std::vector<int> parentStart;             // CSR over children: parents [parentStart[c], parentStart[c + 1])
-    std::vector<int> parents;                 // indices into members
-    std::vector<float> weights;               // sum to 1 over a child's parents
-    std::vector<float> invMass;               // 1/kg per member: its own mass plus its children's shares
+    std::vector<int> termStart;   // CSR over the level's edges: terms [termStart[e], termStart[e + 1])
+    std::vector<int> particle;    // cloth particle id of a term
+    std::vector<float> coef;      // its c_i
+    std::vector<float> rest;      // m, r of each edge: |sum_i c_i X_i| on the rest shape X
   };
-  std::vector<Level> levels;  // levels[0] the finest coarse level
+  std::vector<Level> levels;  // levels[0] the finest coarse level used (the second set: see build)
   int numCloth = 0, maxLevels = 0;  // what it was built for
-  std::vector<Vec3> start;    // m, the displacement at the hierarchy's start (solveHierarchyFrom)
-  std::vector<float> mass;    // kg per cloth particle: its own, or lumped at the coarsest level it is in
 };
 
 namespace {
 
 // a level's graph: the neighbours of each member, as indices into members
 using Graph = std::vector<std::vector<int>>;
+
+// a cluster: (cloth particle id, phi) pairs, phi summing to 1
+using Cluster = std::vector<std::pair<int, float>>;
 
 // the fine graph: the 1-ring of each PBD cloth particle (implicit pieces have their own solver)
 void fineGraph(const Model& model, std::vector<int>& members, Graph& graph) {
@@ -56,7 +52,7 @@ void fineGraph(const Model& model, std::vector<int>& members, Graph& graph) {
 }
 
 // the next level of (members, graph): the pins, then greedily in order every particle none of whose
-// neighbours is taken; returns the taken ones' indices into members
+// neighbours is taken (a maximal independent set); returns the taken ones' indices into members
 std::vector<int> coarsen(const Model& model, const std::vector<int>& members, const Graph& graph) {
   std::vector<uint8_t> taken(members.size(), 0), blocked(members.size(), 0);
   const auto take = [&](size_t a) {
@@ -73,37 +69,72 @@ std::vector<int> coarsen(const Model& model, const std::vector<int>& members, co
   return out;
 }
 
-float restDistance(const Model& model, int i, int j) {
-  return (model.clothRestPosition[i] - model.clothRestPosition[j]).norm();
-}
-
-// builds the level of the taken members of (members, graph), and its own graph into `next`
-void buildLevel(const Model& model, const std::vector<int>& members, const Graph& graph, const std::vector<int>& taken,
-                ClothHierarchy::Level& level, Graph& next) {
-  std::vector<int> local(members.size(), -1);
-  for (size_t c = 0; c < taken.size(); ++c) {
-    local[taken[c]] = static_cast<int>(c);
-    level.members.push_back(members[taken[c]]);
-  }
-  // each other particle's parents: its taken neighbours, weighted by the inverse rest distance
-  level.parentStart.push_back(0);
+// each taken particle's cluster: itself (weight 1) and each other particle of the level below that has
+// it as a neighbour, weighted by its inverse rest distance over all its taken neighbours; phi = the
+// weights over their sum. local: index among the taken, or -1
+std::vector<Cluster> clusters(const Model& model, const std::vector<int>& members, const Graph& graph,
+                              const std::vector<int>& local, size_t count) {
+  std::vector<Cluster> out(count);
   for (size_t a = 0; a < members.size(); ++a) {
-    if (local[a] >= 0) continue;
+    if (local[a] >= 0) {
+      out[local[a]].push_back({members[a], 1.0f});
+      continue;
+    }
+    Cluster parents;
     float sum = 0.0f;
-    const size_t first = level.parents.size();
     for (int b : graph[a])
       if (local[b] >= 0) {
-        const float w = 1.0f / std::max(restDistance(model, members[a], members[b]), 1e-9f);
-        level.parents.push_back(local[b]);
-        level.weights.push_back(w);
-        sum += w;
+        const float dist = (model.clothRestPosition[members[a]] - model.clothRestPosition[members[b]]).norm();
+        parents.push_back({local[b], 1.0f / std::max(dist, 1e-9f)});
+        sum += parents.back().second;
       }
-    if (level.parents.size() == first) continue;  // no taken neighbour: only when the set is not maximal
-    for (size_t k = first; k < level.weights.size(); ++k) level.weights[k] /= sum;
-    level.children.push_back(members[a]);
-    level.parentStart.push_back(static_cast<int>(level.parents.size()));
+    for (const auto& [c, w] : parents) out[c].push_back({members[a], w / sum});
   }
-  // the level's edges: taken particles that are neighbours or share a neighbour below
+  for (Cluster& c : out) {
+    float sum = 0.0f;
+    for (const auto& t : c) sum += t.second;
+    for (auto& t : c) t.second /= sum;
+  }
+  return out;
+}
+
+// the constraint of the edge between clusters a and b: the terms phi_a - phi_b, merged per particle
+// (slot: per cloth particle, its term's index in the edge or -1; left all -1)
+void addEdge(const Model& model, const Cluster& a, const Cluster& b, std::vector<int>& slot,
+             ClothHierarchy::Level& level) {
+  const size_t first = level.particle.size();
+  const auto add = [&](int i, float c) {
+    if (slot[i] >= 0) {
+      level.coef[slot[i]] += c;
+      return;
+    }
+    slot[i] = static_cast<int>(level.particle.size());
+    level.particle.push_back(i);
+    level.coef.push_back(c);
+  };
+  for (const auto& [i, phi] : a) add(i, phi);
+  for (const auto& [i, phi] : b) add(i, -phi);
+  Vec3 rest = Vec3::Zero();
+  for (size_t k = first; k < level.particle.size(); ++k) {
+    rest += level.coef[k] * model.clothRestPosition[level.particle[k]];
+    slot[level.particle[k]] = -1;
+  }
+  level.termStart.push_back(static_cast<int>(level.particle.size()));
+  level.rest.push_back(rest.norm());
+}
+
+// builds the level of the taken members of (members, graph): its edges join taken particles that are
+// neighbours or share a neighbour below; its own graph goes to `next`. False: too many terms
+bool buildLevel(const Model& model, const std::vector<int>& members, const Graph& graph, const std::vector<int>& taken,
+                ClothHierarchy::Level& level, Graph& next) {
+  // a mesh of bounded valence has a few dozen terms a particle; a hub vertex (a fan of thousands of
+  // triangles) would give its square: such a level is not built
+  const size_t maxTerms = 64 * static_cast<size_t>(model.numCloth);
+  std::vector<int> slot(static_cast<size_t>(model.numCloth), -1);
+  std::vector<int> local(members.size(), -1);
+  for (size_t c = 0; c < taken.size(); ++c) local[taken[c]] = static_cast<int>(c);
+  const std::vector<Cluster> cluster = clusters(model, members, graph, local, taken.size());
+  level.termStart.assign(1, 0);
   next.assign(taken.size(), {});
   for (size_t c = 0; c < taken.size(); ++c) {
     const int a = taken[c];
@@ -116,11 +147,10 @@ void buildLevel(const Model& model, const std::vector<int>& members, const Graph
     std::sort(next[c].begin(), next[c].end());
     next[c].erase(std::unique(next[c].begin(), next[c].end()), next[c].end());
     for (int d : next[c])
-      if (d > static_cast<int>(c)) {
-        level.edges.push_back({static_cast<int>(c), d});
-        level.rest.push_back(restDistance(model, level.members[c], level.members[d]));
-      }
+      if (d > static_cast<int>(c)) addEdge(model, cluster[c], cluster[d], slot, level);
+    if (level.particle.size() > maxTerms) return false;
   }
+  return true;
 }
 
 void build(const Model& model, int maxLevels, ClothHierarchy& h) {
@@ -129,56 +159,43 @@ void build(const Model& model, int maxLevels, ClothHierarchy& h) {
   std::vector<int> members;
   Graph graph;
   fineGraph(model, members, graph);
-  for (int l = 0; l < maxLevels; ++l) {
+  // the first set, two fine edges apart, only shapes the next: the constraint iterations already carry
+  // a move that far, and its edges (15 terms each on a triangulated grid) would cost more than the rest
+  for (int l = 0; l <= maxLevels; ++l) {
     const std::vector<int> taken = coarsen(model, members, graph);
     if (taken.size() < 4 || taken.size() == members.size()) break;  // nothing left to join
     ClothHierarchy::Level level;
     Graph next;
-    buildLevel(model, members, graph, taken, level, next);
-    if (level.edges.empty()) break;
-    members = level.members;
+    if (!buildLevel(model, members, graph, taken, level, next) || level.rest.empty()) break;
+    std::vector<int> kept(taken.size());
+    for (size_t c = 0; c < taken.size(); ++c) kept[c] = members[taken[c]];
+    members = std::move(kept);
     graph = std::move(next);
-    h.levels.push_back(std::move(level));
+    if (l > 0) h.levels.push_back(std::move(level));
   }
 }
 
-// each member's inverse mass: its own mass plus the shares of the finer level's particles it carries
-// (weights over their parents), so a coarse move keeps the momentum of the particles it moves; a pinned
-// member (inverse mass 0) stays put. Computed from the present (wet) masses, finest level first
-void lumpMasses(ClothHierarchy& h, const float* invMass, int numCloth) {
-  std::vector<float>& mass = h.mass;
-  mass.resize(static_cast<size_t>(numCloth));
-  for (int i = 0; i < numCloth; ++i) mass[i] = invMass[i] > 0.0f ? 1.0f / invMass[i] : 0.0f;
-  for (ClothHierarchy::Level& level : h.levels) {
-    std::vector<float>& lumped = level.invMass;  // the masses first, inverted below
-    lumped.resize(level.members.size());
-    for (size_t c = 0; c < level.members.size(); ++c) lumped[c] = mass[level.members[c]];
-    for (size_t c = 0; c < level.children.size(); ++c)
-      for (int k = level.parentStart[c]; k < level.parentStart[c + 1]; ++k)
-        lumped[level.parents[k]] += level.weights[k] * mass[level.children[c]];
-    for (size_t c = 0; c < level.members.size(); ++c) {
-      const int i = level.members[c];
-      mass[i] = lumped[c];
-      lumped[c] = invMass[i] > 0.0f && lumped[c] > 0.0f ? 1.0f / lumped[c] : 0.0f;  // held: stays put
+// one Gauss-Seidel pass over the level's edges, each only while its clusters' centres are farther apart
+// than at rest (C > 0: one-sided, a coarse edge that pushed would stop the finer mesh from folding),
+// projected as any PBD constraint over the particles it reads: d_i -= w_i c_i (C / sum_j w_j c_j^2) n,
+// a projection in the mass metric (momentum kept: sum_i c_i = 0; held particles, w = 0, stay)
+void projectLevel(const ClothHierarchy::Level& level, const Vec3* base, Vec3* d, const float* w) {
+  for (size_t e = 0; e + 1 < level.termStart.size(); ++e) {
+    const int first = level.termStart[e], end = level.termStart[e + 1];
+    const Vec3 origin = base[level.particle[first]];  // sum_i c_i = 0: the base enters as differences
+    Vec3 x = Vec3::Zero();
+    float den = 0.0f;
+    for (int k = first; k < end; ++k) {
+      const int i = level.particle[k];
+      const float c = level.coef[k];
+      x += c * ((base[i] - origin) + d[i]);
+      den += w[i] * c * c;
     }
-  }
-}
-
-// one Gauss-Seidel pass over the level's edges, each only when stretched beyond its rest distance
-// (C = |x_a - x_b| - r > 0): a coarse edge that pushed would stop the finer mesh from folding
-void projectLevel(const ClothHierarchy::Level& level, const Vec3* base, Vec3* d) {
-  for (size_t e = 0; e < level.edges.size(); ++e) {
-    const int ca = level.edges[e][0], cb = level.edges[e][1];
-    const float wa = level.invMass[ca], wb = level.invMass[cb];
-    if (wa + wb <= 0.0f) continue;
-    const int a = level.members[ca], b = level.members[cb];
-    const Vec3 x = (base[a] - base[b]) + (d[a] - d[b]);  // x_a - x_b of x = base + d
     const float len = x.norm();
     const float C = len - level.rest[e];
-    if (!(C > 0.0f)) continue;
-    const Vec3 s = (C / ((wa + wb) * len)) * x;
-    d[a] -= wa * s;
-    d[b] += wb * s;
+    if (!(C > 0.0f) || !(den > 0.0f)) continue;
+    const Vec3 step = (C / (den * len)) * x;
+    for (int k = first; k < end; ++k) d[level.particle[k]] -= (w[level.particle[k]] * level.coef[k]) * step;
   }
 }
 
@@ -194,24 +211,9 @@ void solveHierarchyFrom(const Model& model, const Vec3* base, Vec3* displacement
     scratch.hierarchy.reset(new ClothHierarchy);
     build(model, maxLevels, *scratch.hierarchy);
   }
-  ClothHierarchy& h = *scratch.hierarchy;
-  if (h.levels.empty()) return;
-  lumpMasses(h, invMass, model.numCloth);
-  h.start.assign(displacement, displacement + model.numCloth);
-  // coarsest first; a level's children take their parents' moves since the start (what the coarser
-  // levels and this one moved them by), weighted
-  for (auto level = h.levels.rbegin(); level != h.levels.rend(); ++level) {
-    projectLevel(*level, base, displacement);
-    for (size_t c = 0; c < level->children.size(); ++c) {
-      Vec3 move = Vec3::Zero();
-      for (int k = level->parentStart[c]; k < level->parentStart[c + 1]; ++k) {
-        const int i = level->members[level->parents[k]];
-        move += level->weights[k] * (displacement[i] - h.start[i]);
-      }
-      const int child = level->children[c];
-      if (invMass[child] > 0.0f) displacement[child] += move;
-    }
-  }
+  const ClothHierarchy& h = *scratch.hierarchy;
+  for (auto level = h.levels.rbegin(); level != h.levels.rend(); ++level)
+    projectLevel(*level, base, displacement, invMass);
 }
 
 }  // namespace soak
