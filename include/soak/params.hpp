@@ -13,7 +13,7 @@ struct SolverParams {
   int clothSubsteps = 1;          // small steps the PBD cloth takes per substep (Macklin et al. 2019)
   int clothIterations = 8;        // cloth constraint iterations per small step
   bool clothCollidersInSmallSteps = true;  // colliders meet the PBD cloth in each small step (false: once a substep)
-  int clothHierarchy = 6;         // coarse levels the PBD cloth is brought within its rest distances on before each small step's iterations
+  int clothHierarchy = 6;         // coarse levels whose cluster distances the PBD cloth keeps within rest before each small step's iterations
   bool clothGlobalStretch = false;  // a global step brings the PBD cloth's inextensible edges to length in each small step
   int couplingIterations = 2;     // water-cloth coupling passes per substep (Eq. 21)
   Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2

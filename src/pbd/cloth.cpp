@@ -259,8 +259,8 @@ void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, co
   }
 }
 
-// the displacement x* - x taken out of x*, solved (the coarse levels first), and put back: the particles the constraints move
-// (free PBD cloth) get x + displacement; the rest keep their x* as it is
+// the displacement x* - x taken out of x*, solved (the coarse levels first), and put back: the
+// particles the constraints move (free PBD cloth) get x + displacement; the rest keep their x* as it is
 void solveCloth(const Model& model, Particles& p, ClothScratch& scratch, float dt, int iterations) {
   const int n = model.numCloth;
   scratch.displacement.resize(static_cast<size_t>(n));
