@@ -6,8 +6,6 @@
 #include "pbd/cloth.hpp"
 
 #include <algorithm>
-#include <array>
-#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -114,9 +112,12 @@ void addEdge(const Model& model, const Cluster& a, const Cluster& b, std::vector
   };
   for (const auto& [i, phi] : a) add(i, phi);
   for (const auto& [i, phi] : b) add(i, -phi);
+  // sum_k c_k X_k with the X taken relative to the first term's, as projectLevel reads positions, so a
+  // piece far from the origin gets the same r
+  const Vec3 origin = model.clothRestPosition[level.particle[first]];
   Vec3 rest = Vec3::Zero();
   for (size_t k = first; k < level.particle.size(); ++k) {
-    rest += level.coef[k] * model.clothRestPosition[level.particle[k]];
+    rest += level.coef[k] * (model.clothRestPosition[level.particle[k]] - origin);
     slot[level.particle[k]] = -1;
   }
   level.termStart.push_back(static_cast<int>(level.particle.size()));
