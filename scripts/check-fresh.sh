@@ -1,9 +1,16 @@
 #!/usr/bin/env bash
 # The fresh-machine check: builds a minimal Debian 12 root (debootstrap --variant=minbase, from the
-# Debian mirror this machine's own apt sources name), puts a clean clone of this checkout's HEAD in it,
-# and runs the README's two commands there, one after the other (the second reuses the packages and the
-# build of the first), printing how long each took. It fails when either command fails, so a package
-# missing from scripts/setup.sh fails CI (.ci/run calls this after the test suite).
+# Debian mirror this machine's own apt sources name), puts a clean clone of this checkout's HEAD in it
+# (at this checkout's own path inside the root), and runs the README's two commands there, one after the
+# other (the second reuses the packages and the build of the first), printing how long each took. It
+# fails when either command fails, so a package missing from scripts/setup.sh fails CI (.ci/run calls
+# this after the test suite).
+#
+# The root borrows this machine's ccache directory (bind-mounted), so an object compiled here from the
+# same command line, compiler and headers is not compiled again there; ccache still compiles whatever
+# differs, and a header the root lacks is a miss that reaches the compiler and fails as it would
+# without the cache. The clone sits at the same path so that the command lines match. The cache's hits
+# and misses in the root are printed at the end.
 #
 # Needs root (debootstrap, chroot, mount). Only committed work is checked: the clone is of HEAD.
 #
@@ -12,6 +19,7 @@
 #   SOAK_FRESH_KEEP=1  keep the root afterwards (to look inside; it takes a few GB)
 #   SOAK_FRESH_MIRROR  the Debian mirror to use instead of the one in this machine's apt sources
 #   SOAK_FRESH_TIMES   also write the two timings, as JSON, to this file
+#   SOAK_FRESH_CCACHE=0  do not lend this machine's ccache directory to the root (every object compiled)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo="$(pwd)"
@@ -99,15 +107,27 @@ mount -t tmpfs tmpfs "$root/dev/shm" && mounted+=("$root/dev/shm")
 # /sys with its cgroup mount, as a machine has it: slurmd (tests/slurm/) will not start without it
 mount --rbind /sys "$root/sys" && mount --make-rslave "$root/sys" && mounted+=("$root/sys")
 
-git clone --quiet --no-hardlinks "$repo" "$root/work/soak"
-echo "check-fresh: a clean clone of $(git -C "$repo" rev-parse --short HEAD) is in /work/soak of the root"
+git clone --quiet --no-hardlinks "$repo" "$root$repo"
+echo "check-fresh: a clean clone of $(git -C "$repo" rev-parse --short HEAD) is in $repo of the root"
+
+# this machine's compile cache, at the same path in the root (empty where ccache is not installed here)
+cache_dir=""
+if [ "${SOAK_FRESH_CCACHE:-1}" != 0 ] && command -v ccache > /dev/null; then
+  cache_dir="$(ccache -k cache_dir)"
+  mkdir -p "$cache_dir" "$root$cache_dir"
+  mount --bind "$cache_dir" "$root$cache_dir" && mounted+=("$root$cache_dir")
+  ccache --zero-stats > /dev/null
+  echo "check-fresh: the root compiles through this machine's ccache directory $cache_dir"
+fi
 
 # runs one README command in the root, with an environment like a fresh login's
 run_in_root() {
+  local cache_env=()
+  [ -n "$cache_dir" ] && cache_env=(CCACHE_DIR="$cache_dir")
   chroot "$root" /usr/bin/env -i HOME=/root LANG=C.UTF-8 TERM=dumb CI="${CI:-}" \
-    SOAK_SKIP_PORTABLE="${SOAK_SKIP_PORTABLE:-0}" \
+    SOAK_SKIP_PORTABLE="${SOAK_SKIP_PORTABLE:-0}" "${cache_env[@]}" \
     PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-    bash -c "cd /work/soak && $1"
+    bash -c "cd $(printf %q "$repo") && $1"
 }
 
 times=()
@@ -123,6 +143,11 @@ done
 echo "check-fresh: on a fresh minimal Debian 12 ($(nproc) cores):"
 echo "check-fresh:   ./scripts/flagship.sh  ${times[0]} s"
 echo "check-fresh:   ./scripts/test.sh      ${times[1]} s (after the first; it reuses its packages and build)"
+if [ -n "$cache_dir" ]; then
+  # objects taken from the cache (direct or preprocessed hits) against those compiled in the root
+  ccache --print-stats | awk -F'\t' '$1 ~ /^(direct_cache_hit|preprocessed_cache_hit)$/ { h += $2 }
+    $1 == "cache_miss" { m = $2 } END { printf "check-fresh:   ccache: %d objects from the cache, %d compiled\n", h, m }'
+fi
 if [ -n "${SOAK_FRESH_TIMES:-}" ]; then
   printf '{"cores": %d, "flagship_s": %d, "test_s": %d, "commit": "%s"}\n' "$(nproc)" "${times[0]}" "${times[1]}" \
     "$(git -C "$repo" rev-parse --short HEAD)" > "$SOAK_FRESH_TIMES"
