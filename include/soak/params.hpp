@@ -14,6 +14,8 @@ struct SolverParams {
   int clothIterations = 8;        // cloth constraint iterations per small step
   bool clothCollidersInSmallSteps = true;  // colliders meet the PBD cloth in each small step (false: once a substep)
   int clothHierarchy = 6;         // coarse levels whose cluster distances the PBD cloth keeps within rest before each small step's iterations
+  int clothPinPasses = 8;         // extra passes, before each small step's iterations, over the inextensible edges near a pinned particle
+  int clothPinRings = 5;          // how near: edges within this many edges of a pinned particle
   bool clothGlobalStretch = false;  // a global step brings the PBD cloth's inextensible edges to length in each small step
   int couplingIterations = 2;     // water-cloth coupling passes per substep (Eq. 21)
   Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2

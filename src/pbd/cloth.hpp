@@ -85,8 +85,9 @@ void solveClothFrom(const Model& model, const Vec3* base, Vec3* displacement, co
 // clusters whose particles are neighbours or share one below are joined by a constraint |centre_a -
 // centre_b| <= its rest value, projected as a PBD constraint over the clusters' particles (mass
 // weighted, momentum kept). Coarsest first, one Gauss-Seidel pass a level, only the stretched edges
-// (never pushing, so the cloth folds freely). Built at the first call; moves only free PBD cloth
-// (docs/models.md, Eq. 8, "The coarse levels")
+// (never pushing, so the cloth folds freely). Then solver.clothPinPasses passes over the inextensible
+// edges within solver.clothPinRings edges of a pin, stretched ones only. Built at the first call; moves
+// only free PBD cloth (docs/models.md, Eq. 8, "The coarse levels" and "The pins' neighbourhood")
 void solveHierarchyFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                         ClothScratch& scratch);
 

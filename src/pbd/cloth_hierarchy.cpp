@@ -2,7 +2,8 @@
 // dynamics"): before each small step's constraint iterations, the distances between the centres of a few
 // coarser meshes' clusters of particles are brought within their rest values, coarsest first, so that the
 // load a pin holds reaches the whole sheet within one small step instead of a few edges an iteration
-// (docs/models.md, Eq. 8, "The coarse levels").
+// (docs/models.md, Eq. 8, "The coarse levels"). Then solver.clothPinPasses passes over the inextensible
+// edges near the pins, where that load concentrates (docs/models.md, Eq. 8, "The pins' neighbourhood").
 #include "pbd/cloth.hpp"
 
 #include <algorithm>
@@ -21,7 +22,8 @@ struct ClothHierarchy {
     std::vector<float> rest;      // m, r of each edge: |sum_i c_i X_i| on the rest shape X
   };
   std::vector<Level> levels;  // levels[0] the finest coarse level used (the second set: see build)
-  int numCloth = 0, maxLevels = 0;  // what it was built for
+  Level pinRegion;            // the inextensible fine edges near the pins, each two terms (+1, -1)
+  int numCloth = 0, maxLevels = 0, pinRings = 0;  // what it was built for
 };
 
 namespace {
@@ -154,15 +156,53 @@ bool buildLevel(const Model& model, const std::vector<int>& members, const Graph
   return true;
 }
 
-void build(const Model& model, int maxLevels, ClothHierarchy& h) {
+// the inextensible stretch edges (compliance 0) of the PBD cloth with both ends within `rings` edges of a
+// pinned particle: a pin holds the load of the cloth below it, which reaches it through these few edges,
+// so the constraint error of a few iterations concentrates on them (a point support's stress rises as
+// 1/distance). Edges between two pins hold nothing and are left out.
+ClothHierarchy::Level pinRegion(const Model& model, int rings) {
+  const int n = model.numCloth;
+  std::vector<int> ring(static_cast<size_t>(n), -1), front, next;
+  for (int i = 0; i < n; ++i)
+    if (model.clothPinned[i] && !model.implicitCloth(i)) {
+      ring[i] = 0;
+      front.push_back(i);
+    }
+  for (int r = 1; r <= rings && !front.empty(); ++r, front.swap(next)) {  // breadth first over the 1-rings
+    next.clear();
+    for (int i : front)
+      for (int k = model.vertexNeighborStart[i]; k < model.vertexNeighborStart[i + 1]; ++k)
+        if (const int j = model.vertexNeighbors[k]; ring[j] < 0 && !model.implicitCloth(j)) {
+          ring[j] = r;
+          next.push_back(j);
+        }
+  }
+  ClothHierarchy::Level level;
+  level.termStart.assign(1, 0);
+  const StretchConstraints& st = model.stretch;
+  for (size_t k = 0; k < st.ids.size(); ++k) {
+    const auto [a, b] = st.ids[k];
+    if (st.compliance[k] != 0.0f || ring[a] < 0 || ring[b] < 0 || (model.clothPinned[a] && model.clothPinned[b]))
+      continue;
+    level.particle.insert(level.particle.end(), {a, b});
+    level.coef.insert(level.coef.end(), {1.0f, -1.0f});
+    level.termStart.push_back(static_cast<int>(level.particle.size()));
+    level.rest.push_back(st.restLength[k]);
+  }
+  return level;
+}
+
+void build(const Model& model, int maxLevels, int pinRings, ClothHierarchy& h) {
   h.numCloth = model.numCloth;
   h.maxLevels = maxLevels;
+  h.pinRings = pinRings;
+  if (pinRings > 0) h.pinRegion = pinRegion(model, pinRings);
   std::vector<int> members;
   Graph graph;
   fineGraph(model, members, graph);
   // the first set, two fine edges apart, only shapes the next: the constraint iterations already carry
   // a move that far, and its edges (15 terms each on a triangulated grid) would cost more than the rest
-  for (int l = 0; l <= maxLevels; ++l) {
+  for (int l = 0; maxLevels > 0 && l <= maxLevels; ++l) {
     const std::vector<int> taken = coarsen(model, members, graph);
     if (taken.size() < 4 || taken.size() == members.size()) break;  // nothing left to join
     ClothHierarchy::Level level;
@@ -206,15 +246,18 @@ void ClothHierarchyDeleter::operator()(ClothHierarchy* h) const { delete h; }
 
 void solveHierarchyFrom(const Model& model, const Vec3* base, Vec3* displacement, const float* invMass,
                         ClothScratch& scratch) {
-  const int maxLevels = model.solver.clothHierarchy;
-  if (maxLevels <= 0 || model.numCloth == 0) return;
-  if (!scratch.hierarchy || scratch.hierarchy->numCloth != model.numCloth || scratch.hierarchy->maxLevels != maxLevels) {
-    scratch.hierarchy.reset(new ClothHierarchy);
-    build(model, maxLevels, *scratch.hierarchy);
+  const int maxLevels = model.solver.clothHierarchy, pinPasses = model.solver.clothPinPasses;
+  const int pinRings = pinPasses > 0 ? model.solver.clothPinRings : 0;
+  if ((maxLevels <= 0 && pinPasses <= 0) || model.numCloth == 0) return;
+  ClothHierarchy* h = scratch.hierarchy.get();
+  if (!h || h->numCloth != model.numCloth || h->maxLevels != maxLevels || h->pinRings != pinRings) {
+    scratch.hierarchy.reset(h = new ClothHierarchy);
+    build(model, maxLevels, pinRings, *h);
   }
-  const ClothHierarchy& h = *scratch.hierarchy;
-  for (auto level = h.levels.rbegin(); level != h.levels.rend(); ++level)
+  for (auto level = h->levels.rbegin(); level != h->levels.rend(); ++level)
     projectLevel(*level, base, displacement, invMass);
+  // the pins' neighbourhood after the levels, which have just moved the cloth under it toward rest
+  for (int pass = 0; pass < pinPasses; ++pass) projectLevel(h->pinRegion, base, displacement, invMass);
 }
 
 }  // namespace soak

@@ -107,6 +107,8 @@ void readSolver(ObjectReader r, SolverParams& s, float& maxMemoryGB) {
   s.clothIterations = r.integer("clothIterations", d.clothIterations, loops0);
   s.clothCollidersInSmallSteps = r.boolean("clothCollidersInSmallSteps", d.clothCollidersInSmallSteps);
   s.clothHierarchy = r.integer("clothHierarchy", d.clothHierarchy, Range::between(0, 16));
+  s.clothPinPasses = r.integer("clothPinPasses", d.clothPinPasses, Range::between(0, 64));
+  s.clothPinRings = r.integer("clothPinRings", d.clothPinRings, Range::between(1, 64));
   s.clothGlobalStretch = r.boolean("clothGlobalStretch", d.clothGlobalStretch);
   s.couplingIterations = r.integer("couplingIterations", d.couplingIterations, loops0);
   s.gravity = r.vec3("gravity", d.gravity);

@@ -49,13 +49,14 @@ Vec3d massMoment(const Particles& p, int n, const std::vector<Vec3>& x) {
 }  // namespace
 
 TEST(GlobalStretch, AHeavySheetWithoutTethersHangsInextensibleAndStill) {
-  // measured: 0.25% against 139% without the step at 0.6 s; at rest (1.8 s) the fastest particle 1.3e-4 m/s
+  // measured: 0.25% against 32% without the step (the coarse levels and pin passes on, as by default) at
+  // 0.6 s; at rest (1.8 s) the fastest particle 1.3e-4 m/s
   Scene off = sceneFromJson(heavySheet(true), {"solver.clothGlobalStretch=false"});
   runSteps(off, 40);
   Scene on = sceneFromJson(heavySheet(true));
   runSteps(on, 40);
   const float strainOff = maxStrain(off, off.state.particles.x), strainOn = maxStrain(on, on.state.particles.x);
-  EXPECT_GT(strainOff, 0.5f);
+  EXPECT_GT(strainOff, 0.25f);
   EXPECT_LT(strainOn, 0.005f);
   runSteps(on, 80);
   const Particles& p = on.state.particles;
