@@ -1,8 +1,9 @@
 // the PBD cloth's coarse levels (solver.clothHierarchy) and the passes near the pins
 // (solver.clothPinPasses, both src/pbd/cloth_hierarchy.cpp): a sheet without tethers hangs within 10% of
-// its length at Fig. 5's and Fig. 1's small steps; the levels keep a free piece's momentum whatever its
-// wet masses, never push a slack sheet, leave held particles alone and do nothing unasked; the pin passes
-// move only the inextensible edges near a pin; the same state on any thread count
+// its length at Fig. 5's small steps, and the pin passes hold the edges at its pins at Fig. 1's; the
+// levels keep a free piece's momentum whatever its wet masses, never push a slack sheet, leave held
+// particles alone and do nothing unasked; the pin passes move only the inextensible edges near a pin;
+// the same state on any thread count
 #include "support/run_scene.hpp"
 
 #include "pbd/cloth.hpp"
