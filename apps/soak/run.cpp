@@ -157,6 +157,12 @@ int validateCommand(const ValidateOptions& o) {
                                : std::string();
   std::printf("  iterations:  fluid %d%s, cloth %d, coupling %d\n", s.fluidIterations, upTo.c_str(), s.clothIterations,
               s.couplingIterations);
+  bool pbdCloth = false;
+  for (const ClothPiece& p : m.pieces) pbdCloth = pbdCloth || p.solver == ClothSolver::Pbd;
+  if (pbdCloth)  // the PBD cloth's convergence settings (docs/models.md, Eq. 8)
+    std::printf("  PBD cloth:   %d small steps a substep, %d coarse levels, %d passes within %d edges of a pin%s\n",
+                s.clothSubsteps, s.clothHierarchy, s.clothPinPasses, s.clothPinRings,
+                s.clothGlobalStretch ? ", global stretch step" : "");
   if (m.wetting.enabled)
     std::printf("  wetting:     Shao 2017, %s\n", m.wetting.everySubstep ? "after every substep" : "once a step (Algorithm 1)");
   std::printf("  output:      %d frames of %d steps (%g s simulated)\n", scene.output.frames,

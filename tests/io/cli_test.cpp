@@ -218,9 +218,13 @@ TEST(CliExportBody, WritesTheMannequinAsAnObjSequence) {
 TEST(CliValidate, SummaryCountsParticlesAndPieces) {
   const Cli cli("summary");
   const std::string scene = cli.writeScene("tiny.json", kTinyScene);
-  const Result r = cli.run("validate '" + scene + "' --set solver.substeps=3");
+  const Result r = cli.run("validate '" + scene + "' --set solver.substeps=3 --set solver.clothPinPasses=3");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("100 cloth"), std::string::npos) << r.out;
+  // the PBD cloth's convergence settings, as set
+  EXPECT_NE(r.out.find("PBD cloth:   1 small steps a substep, 6 coarse levels, 3 passes within 5 edges of a pin\n"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("64 water from blocks"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("1 pieces"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("3 substeps"), std::string::npos) << r.out;
@@ -271,7 +275,7 @@ TEST(CliBench, TimesEachSceneInItsOwnProcess) {
   const std::string b = cli.writeScene("tiny_b.json", kTinyScene);
   const fs::path json = cli.dir() / "bench.json";
   const Result r = cli.run("bench --scene '" + a + "' --scene '" + b + "' --steps 2 --warmup 1 --threads 1 --stages --json '" +
-                           json.string() + "'");
+                           json.string() + "' --set solver.clothHierarchy=2");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("tiny_a"), std::string::npos) << r.out;
   // --stages: a second table of the stages' parts, a line a scene
@@ -287,6 +291,8 @@ TEST(CliBench, TimesEachSceneInItsOwnProcess) {
     EXPECT_EQ(res["particles"]["water"], kTinyWater);
     EXPECT_EQ(res["steps"], 2);
     EXPECT_EQ(res["threads"], 1);
+    EXPECT_EQ(res["clothSolve"]["hierarchy"], 2);  // as --set
+    EXPECT_EQ(res["clothSolve"]["pinPasses"], 8);
     EXPECT_GT(res["msPerStepMedian"]["total"].get<double>(), 0.0);
     EXPECT_GT(res["msPerStepMedianParts"]["neighbors.lists"].get<double>(), 0.0);
     EXPECT_LE(res["msPerStepMeanParts"]["neighbors.lists"].get<double>(),
