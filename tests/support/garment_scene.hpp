@@ -1,4 +1,4 @@
-// helpers for the tests of Chen 2012 scenes (tests/garment/stage_test.cpp, tests/scene/chen_keys_test.cpp):
+// helpers for the tests of Chen 2012 scenes (tests/garment/stage_test.cpp, run_test.cpp, tests/scene/chen_keys_test.cpp):
 // a small implicit sheet under rain, loading from a string as "garment.json", the load error, and a run
 #pragma once
 #include <soak/error.hpp>
