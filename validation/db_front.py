@@ -19,9 +19,7 @@ import soakrun
 a, g, x0 = 0.3, 9.81, -0.9  # column width = height, back wall
 n = 1.0                      # n^2 = height / width
 # Martin & Moyce 1952, n^2 = 1: (T, Z)
-MM = np.array([(0.43, 1.11), (0.62, 1.22), (0.80, 1.44), (0.97, 1.67), (1.14, 1.89), (1.29, 2.11), (1.45, 2.33),
-               (1.62, 2.56), (1.76, 2.78), (1.93, 3.00), (2.07, 3.22), (2.24, 3.44), (2.40, 3.67), (2.54, 3.89),
-               (2.71, 4.11), (2.87, 4.33), (3.04, 4.56)])
+MM = np.loadtxt(os.path.join(os.path.dirname(os.path.abspath(__file__)), "martin_moyce_1952.csv"), delimiter=",")
 
 out = sys.argv[1]
 st = soakrun.stats(out)

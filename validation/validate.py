@@ -27,9 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DOCS = os.path.join(soakrun.ROOT, "docs")
 G = 9.81
 # Martin & Moyce 1952, square column (n^2 = 1): surge front Z = z/a at T = t sqrt(g/a)
-MARTIN_MOYCE = np.array([(0.43, 1.11), (0.62, 1.22), (0.80, 1.44), (0.97, 1.67), (1.14, 1.89), (1.29, 2.11),
-                         (1.45, 2.33), (1.62, 2.56), (1.76, 2.78), (1.93, 3.00), (2.07, 3.22), (2.24, 3.44),
-                         (2.40, 3.67), (2.54, 3.89), (2.71, 4.11), (2.87, 4.33), (3.04, 4.56)])
+MARTIN_MOYCE = np.loadtxt(os.path.join(HERE, "martin_moyce_1952.csv"), delimiter=",")
 
 
 def water_frames(out):
@@ -81,7 +79,9 @@ def dam_break(work):
     solved to 32 iterations, 12.3% with 2 substeps, and 3.6-9.1% ahead at every later point. So the miss at
     T = 0.62 is the experiment's release (Martin & Moyce's column starts behind the instantly released one
     and the converged solution does not come back to it), not a solve that falls short; no model of the
-    release is in the scene (the paper's release speed is not at hand)."""
+    release is in the scene (the paper's release speed is not at hand).
+    The suite's tests/sim/dam_break_test.cpp runs the three substep counts (0.6 s each) and holds their
+    fronts within 10.5% of the measured one (8% from T = 0.8 on) and within 6.5% of each other."""
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(MARTIN_MOYCE[:, 0], MARTIN_MOYCE[:, 1], "ko", label="Martin & Moyce 1952")
     rows = []
