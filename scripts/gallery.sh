@@ -13,7 +13,7 @@
 #   newer than the scene file and every pattern file); pass --fresh to run every scene again.
 # Environment: SOAK (default build/soak), THREADS (default 2); OMP_WAIT_POLICY defaults to PASSIVE.
 #
-# scripts/gallery_numbers.py [--work's folder] prints the numbers the captions quote, measured on these runs.
+# scripts/gallery_numbers.py [WORK] prints the numbers the captions quote, measured on the runs in WORK.
 # Needs povray and ffmpeg (scripts/setup.sh installs them). Times on 2 shared cores are in
 # docs/gallery.md. The runs are shortened to the still's frame (`soak run --frames F`), which gives
 # the same frames as a whole run.
