@@ -236,8 +236,8 @@ def write_report(results):
              f"Written by `validation/validate.py` on {datetime.date.today()} at commit {commit} (build/soak, 2 threads).",
              "Each row: the case, its target, what soak measured, and whether it holds. Scenes in `validation/`;",
              "`./scripts/validate.sh` installs python3-matplotlib, builds soak and rewrites this page (about 15 minutes).",
-             "Targets are issue 22's; a row that does not hold is listed as such, and its section says why",
-             "(the dam break at 1 substep: the converged and the refined solves miss the same point, T = 0.62).",
+             "Targets are issue 22's; a row that does not hold is listed as such, and its case's section below",
+             "says what is known of why.",
              "", "| case | target | measured | holds |", "|---|---|---|---|"]
     for name, (rows, _) in results.items():
         for case, target, measured, ok in rows:
