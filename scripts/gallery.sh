@@ -13,7 +13,7 @@
 #   newer than the scene file and every pattern file); pass --fresh to run every scene again.
 # Environment: SOAK (default build/soak), THREADS (default 2); OMP_WAIT_POLICY defaults to PASSIVE.
 #
-# scripts/gallery_numbers.py [WORK] prints the numbers the captions quote, measured on the runs in WORK.
+# At the end it prints the numbers the captions quote, measured on the runs (scripts/gallery_numbers.py).
 # Needs povray and ffmpeg (scripts/setup.sh installs them). Times on 2 shared cores are in
 # docs/gallery.md. The runs are shortened to the still's frame (`soak run --frames F`), which gives
 # the same frames as a whole run.
@@ -189,3 +189,14 @@ for s in "${stills[@]}"; do
   "still_$s"
   log "$s: done in $((SECONDS - t0)) s"
 done
+
+# the numbers the captions of docs/gallery.md quote, measured on these runs (the demos quote none;
+# obj_body's are scripts/obj-body.sh's)
+measured=()
+for s in "${stills[@]}"; do
+  case "$s" in dam_break | drape_sphere | obj_body) ;; *) measured+=("$s") ;; esac
+done
+if [ ${#measured[@]} -gt 0 ]; then
+  log "the numbers the captions quote (scripts/gallery_numbers.py):"
+  /usr/bin/python3 scripts/gallery_numbers.py "$work" "${measured[@]}"
+fi

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Prints the numbers docs/gallery.md's captions quote, measured on the runs scripts/gallery.sh left in
 its work folder, so that a remade gallery's captions can be checked and updated.
 
