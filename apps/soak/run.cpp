@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 
 namespace soak::cli {
@@ -157,8 +158,8 @@ int validateCommand(const ValidateOptions& o) {
                                : std::string();
   std::printf("  iterations:  fluid %d%s, cloth %d, coupling %d\n", s.fluidIterations, upTo.c_str(), s.clothIterations,
               s.couplingIterations);
-  bool pbdCloth = false;
-  for (const ClothPiece& p : m.pieces) pbdCloth = pbdCloth || p.solver == ClothSolver::Pbd;
+  const bool pbdCloth = std::any_of(m.pieces.begin(), m.pieces.end(),
+                                    [](const ClothPiece& p) { return p.solver == ClothSolver::Pbd; });
   if (pbdCloth)  // the PBD cloth's convergence settings (docs/models.md, Eq. 8)
     std::printf("  PBD cloth:   %d small steps a substep, %d coarse levels, %d passes within %d edges of a pin%s\n",
                 s.clothSubsteps, s.clothHierarchy, s.clothPinPasses, s.clothPinRings,

@@ -7,6 +7,7 @@
 #include "pbd/cloth.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -162,18 +163,19 @@ bool buildLevel(const Model& model, const std::vector<int>& members, const Graph
 // 1/distance). Edges between two pins hold nothing and are left out.
 ClothHierarchy::Level pinRegion(const Model& model, int rings) {
   const int n = model.numCloth;
-  std::vector<int> ring(static_cast<size_t>(n), -1), front, next;
+  std::vector<uint8_t> near(static_cast<size_t>(n), 0);  // within `rings` edges of a pin
+  std::vector<int> front, next;
   for (int i = 0; i < n; ++i)
     if (model.clothPinned[i] && !model.implicitCloth(i)) {
-      ring[i] = 0;
+      near[i] = 1;
       front.push_back(i);
     }
   for (int r = 1; r <= rings && !front.empty(); ++r, front.swap(next)) {  // breadth first over the 1-rings
     next.clear();
     for (int i : front)
       for (int k = model.vertexNeighborStart[i]; k < model.vertexNeighborStart[i + 1]; ++k)
-        if (const int j = model.vertexNeighbors[k]; ring[j] < 0 && !model.implicitCloth(j)) {
-          ring[j] = r;
+        if (const int j = model.vertexNeighbors[k]; !near[j] && !model.implicitCloth(j)) {
+          near[j] = 1;
           next.push_back(j);
         }
   }
@@ -182,7 +184,7 @@ ClothHierarchy::Level pinRegion(const Model& model, int rings) {
   const StretchConstraints& st = model.stretch;
   for (size_t k = 0; k < st.ids.size(); ++k) {
     const auto [a, b] = st.ids[k];
-    if (st.compliance[k] != 0.0f || ring[a] < 0 || ring[b] < 0 || (model.clothPinned[a] && model.clothPinned[b]))
+    if (st.compliance[k] != 0.0f || !near[a] || !near[b] || (model.clothPinned[a] && model.clothPinned[b]))
       continue;
     level.particle.insert(level.particle.end(), {a, b});
     level.coef.insert(level.coef.end(), {1.0f, -1.0f});
