@@ -106,6 +106,34 @@ INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedGarments,
                                            ShippedGarment{"garment_dress_rain.json", 0.45, 0, true, "solver.substeps=4"},
                                            ShippedGarment{"garment_skirt.json", 0.44, 0, false}));
 
+// issue 23 point 3 on the garment scenes in rain as they ship (full resolution, their rain, their
+// solver): after 1.5 s (sewn by 0.5 s, the rain on the fabric from about 0.7 s) no vertex is inside
+// the body's contact margin, no triangle passes through another, every solve converged, the layers
+// met (the self-collision pushed) and the fabric took water. Measured: every vertex at the margin,
+// none crossing; 31 and 5,353 pushes, 204 and 160 drops taken. Without the self-collision the dress has
+// 100 crossing pairs by then
+class ShippedRainScenes : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ShippedRainScenes, AsShippedNoVertexInTheBodyAndNoTriangleThroughAnother) {
+  Scene s = loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/" + GetParam());
+  const Model& m = s.model;
+  StepStats total;
+  testing::run(m, s.state, 90, &total);
+  const auto& x = s.state.particles.x;
+  float deepest = 1e30f;
+  for (int i = 0; i < m.numCloth; ++i)
+    deepest = std::min(deepest, bodyDistance(m.colliders, s.state.time, x[size_t(i)], nullptr));
+  EXPECT_GT(deepest, 0.5f * m.pieces[0].material.thickness - 5e-4f);  // measured at the margin
+  const std::vector<Vec3> cloth(x.begin(), x.begin() + m.numCloth);
+  EXPECT_EQ(testing::countCrossingTriangles(cloth, m.triangles, m.pieces[0].seams), 0u);
+  EXPECT_EQ(total.garment.unconverged, 0u);
+  EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
+  EXPECT_GT(total.garment.dropsTaken, 50u);
+}
+
+INSTANTIATE_TEST_SUITE_P(PatternScene, ShippedRainScenes,
+                         ::testing::Values("chen_fig9_garment_rain_wet.json", "garment_dress_rain.json"));
+
 // the shipped moving-body scene (scenes/garment_tshirt_moving.json, without its rain), the shirt at
 // 4 cm: the mannequin raises its arms to 70 degrees (1.5 s to 3 s) and lowers them (to 4.5 s). Every
 // solve converges, no vertex ends inside the moving body, the shirt rides up with the arms and comes
