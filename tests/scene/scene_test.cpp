@@ -5,6 +5,7 @@
 #include <soak/scene.hpp>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include <filesystem>
@@ -32,6 +33,24 @@ TEST(SceneFiles, EveryShippedSceneLoadsWithADescription) {
     ++count;
   }
   EXPECT_GE(count, 3);
+}
+
+// the dry and wet scenes that the gallery and the dry/wet movies compare differ only in the rain: the
+// name, the description, the emitters and whether the water is written out
+TEST(SceneFiles, DryAndWetTwinsDifferOnlyInTheRain) {
+  const auto withoutRain = [](const std::string& name) {
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(fs::path(SOAK_SOURCE_DIR) / "scenes" / name));
+    for (const char* key : {"name", "description", "emitters"}) j.erase(key);
+    j["output"].erase("water");
+    return j;
+  };
+  for (const auto& [dry, wet] : {std::pair{"chen_fig8_silk_sphere_dry.json", "chen_fig8_silk_sphere_wet.json"},
+                                 std::pair{"chen_fig9_garment_rain_dry.json", "chen_fig9_garment_rain_wet.json"},
+                                 std::pair{"garment_tshirt_moving_dry.json", "garment_tshirt_moving.json"}}) {
+    EXPECT_EQ(withoutRain(dry), withoutRain(wet)) << dry << " against " << wet;
+    EXPECT_TRUE(loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/" + dry).model.emitters.empty()) << dry;
+    EXPECT_FALSE(loadScene(std::string(SOAK_SOURCE_DIR) + "/scenes/" + wet).model.emitters.empty()) << wet;
+  }
 }
 
 TEST(SceneFiles, Fig3aHasThePapersParticleCounts) {
