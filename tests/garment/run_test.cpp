@@ -1,7 +1,8 @@
 // Chen 2012 garments in whole runs (garment/stage.cpp inside the step): rain wets a garment by the water
 // it takes and every drop is accounted, a saturated sheet takes no more, a CG stopped at its cap is
 // counted, heavier cloth hangs lower (the wet silk on the ball, the soaked shirt), the garment stays out
-// of the mannequin at its vertices, edges and triangles, and one and two threads give the same state
+// of the mannequin at its vertices, edges and triangles, an OBJ-sequence body carries the garment on it,
+// and one and two threads give the same state
 #include <soak/error.hpp>
 #include <soak/output.hpp>
 #include <soak/scene.hpp>
@@ -17,6 +18,8 @@
 #include "world/garment_mesh.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -275,6 +278,41 @@ TEST(GarmentRun, SameStateForOneAndTwoThreads) {
   const uint64_t two = hashWith(2);
   setThreadCount(2);
   EXPECT_EQ(one, two);
+}
+
+// a user's animated body (issue 23 point 1) for the implicit garment: an OBJ sequence of a slab that
+// slides sideways at 0.5 m/s from t = 0.2 s carries a sheet lying on it through the contact rows'
+// friction, which takes the sequence's surface velocity; without friction the slab slides out from
+// under a sheet that stays where it was
+TEST(GarmentRun, AnObjSequenceBodyCarriesTheGarmentOnIt) {
+  const std::string dir = ::testing::TempDir() + "/soak_garment_sequence";
+  std::filesystem::create_directories(dir);
+  for (int f = 0; f <= 10; ++f) {  // a 2 x 0.2 x 2 m slab, its top at y = 1, 5 cm further in x each frame
+    std::ofstream obj(dir + "/slab_" + std::to_string(f) + ".obj");
+    for (int k = 0; k < 8; ++k)
+      obj << "v " << (k & 1 ? 1.0 : -1.0) + 0.05 * f << " " << (k & 2 ? 1.0 : 0.8) << " " << (k & 4 ? 1.0 : -1.0) << "\n";
+    obj << "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\n"
+           "f 2 4 6\nf 4 8 6\n";
+  }
+  const std::string scene = R"({
+    "solver": {"dt": 0.0166667, "substeps": 2, "domain": {"min": [-2, 0, -2], "max": [2, 2, 2]}},
+    "colliders": [{"name": "slab", "type": "meshSequence", "path": ")" + dir + R"(/slab_#.obj", "fps": 10,
+                   "start": 0.2, "friction": 1.0}],
+    "cloth": [{"name": "sheet", "solver": "implicit", "fabric": "cotton",
+               "mesh": {"type": "rectangle", "center": [0, 1.004, 0], "size": [0.4, 0.4], "resolution": [11, 11]},
+               "material": {"particleMass": 2e-4, "thickness": 0.008}}]})";
+  const auto meanVelocityX = [](const Scene& s) {
+    double sum = 0.0;
+    for (int i = 0; i < s.model.numCloth; ++i) sum += s.state.particles.v[size_t(i)].x();
+    return sum / s.model.numCloth;
+  };
+  Scene carried = fromString(scene);
+  run(carried.model, carried.state, 48);  // 0.8 s: 0.6 s of sliding
+  EXPECT_NEAR(meanVelocityX(carried), 0.5, 0.01);  // measured 0.5000: sticking
+  Scene slipping = fromString(scene, {"colliders.0.friction=0"});
+  run(slipping.model, slipping.state, 48);
+  EXPECT_LT(std::abs(meanVelocityX(slipping)), 0.01);  // measured 3e-9
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
