@@ -209,14 +209,8 @@ TEST(GarmentScene, MeshColliderFromAnObjFile) {
 TEST(GarmentScene, MeshSequenceColliderFromObjFrames) {
   const std::string dir = ::testing::TempDir() + "/soak_sequence_scene";
   std::filesystem::create_directories(dir);
-  for (int f = 1; f <= 3; ++f) {
-    // a cube of 100 cm (scale 0.01: 1 m) whose top rises 10 cm a frame
-    std::ofstream obj(dir + "/lift_" + std::to_string(f) + ".obj");
-    for (int k = 0; k < 8; ++k)
-      obj << "v " << (k & 1 ? 50 : -50) << " " << (k & 2 ? 50 + 10 * (f - 1) : -50) << " " << (k & 4 ? 50 : -50) << "\n";
-    obj << "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\n"
-           "f 2 4 6\nf 4 8 6\n";
-  }
+  for (int f = 1; f <= 3; ++f)  // a cube of 100 cm (scale 0.01: 1 m) whose top rises 10 cm a frame
+    writeBoxObj(dir + "/lift_" + std::to_string(f) + ".obj", Vec3(-50, -50, -50), Vec3(50, 50 + 10 * (f - 1), 50));
   const std::string scene = R"({"colliders": [{"name": "lift", "type": "meshSequence", "path": ")" + dir +
                             R"(/lift_#.obj", "fps": 10, "start": 0.5, "scale": 0.01, "position": [0, 1, 0]}],
     "emitters": [{"type": "block", "min": [-0.1, 2, -0.1], "max": [0.1, 2.2, 0.1]}]})";

@@ -52,6 +52,13 @@ TEST(PatternScene, KeysReachTheModel) {
   EXPECT_HAS(loadError(sceneWith(kTube), {"cloth.0.garment.seams.settleTime=-1"}), "settleTime");
 }
 
+// pairs of the first piece's triangles through each other (mesh_crossings.hpp), its seams joined
+size_t crossingPairs(const Scene& s) {
+  const auto& x = s.state.particles.x;
+  const std::vector<Vec3> cloth(x.begin(), x.begin() + s.model.numCloth);
+  return testing::countCrossingTriangles(cloth, s.model.triangles, s.model.pieces[0].seams);
+}
+
 // the shipped garments: their seams close, no vertex ends inside the body, and the garment stays on
 struct ShippedGarment {
   const char* scene;
@@ -81,18 +88,13 @@ TEST_P(ShippedGarments, SewShutOnTheBodyAndStayOn) {
   for (const auto& [a, b] : piece.seams) gap = std::max(gap, (x[a] - x[b]).norm());
   EXPECT_LT(gap, 0.001f);  // measured 0.06 to 0.36 mm
   const float thickness = piece.material.thickness;
-  float deepest = 1e30f;
   double lowest = 1e30;
-  for (int i = 0; i < m.numCloth; ++i) {
-    deepest = std::min(deepest, bodyDistance(m.colliders, s.state.time, x[size_t(i)], nullptr));
-    lowest = std::min(lowest, double(x[size_t(i)].y()));
-  }
-  EXPECT_GT(deepest, 0.5f * thickness - 5e-4f);  // every vertex outside the contact margin (measured at it)
+  for (int i = 0; i < m.numCloth; ++i) lowest = std::min(lowest, double(x[size_t(i)].y()));
+  EXPECT_GT(testing::deepestClothVertex(s), 0.5f * thickness - 5e-4f);  // every vertex outside the contact margin (measured at it)
   EXPECT_GT(total.garment.contacts, 0u);         // it rests on the body
   EXPECT_GT(lowest, GetParam().lowest);
   EXPECT_EQ(total.garment.unconverged, 0u);
-  const std::vector<Vec3> cloth(x.begin(), x.begin() + m.numCloth);
-  EXPECT_LE(testing::countCrossingTriangles(cloth, m.triangles, piece.seams), GetParam().crossings);
+  EXPECT_LE(crossingPairs(s), GetParam().crossings);
   if (GetParam().layersMeet) EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
 }
 
@@ -119,13 +121,8 @@ TEST_P(ShippedRainScenes, AsShippedNoVertexInTheBodyAndNoTriangleThroughAnother)
   const Model& m = s.model;
   StepStats total;
   testing::run(m, s.state, 90, &total);
-  const auto& x = s.state.particles.x;
-  float deepest = 1e30f;
-  for (int i = 0; i < m.numCloth; ++i)
-    deepest = std::min(deepest, bodyDistance(m.colliders, s.state.time, x[size_t(i)], nullptr));
-  EXPECT_GT(deepest, 0.5f * m.pieces[0].material.thickness - 5e-4f);  // measured at the margin
-  const std::vector<Vec3> cloth(x.begin(), x.begin() + m.numCloth);
-  EXPECT_EQ(testing::countCrossingTriangles(cloth, m.triangles, m.pieces[0].seams), 0u);
+  EXPECT_GT(testing::deepestClothVertex(s), 0.5f * m.pieces[0].material.thickness - 5e-4f);  // measured at the margin
+  EXPECT_EQ(crossingPairs(s), 0u);
   EXPECT_EQ(total.garment.unconverged, 0u);
   EXPECT_GT(total.garment.selfContacts, 0u) << "a weak case: the layers never met";
   EXPECT_GT(total.garment.dropsTaken, 50u);
@@ -147,13 +144,8 @@ TEST(PatternScene, TheShirtFollowsTheMovingBody) {
   const auto& x = s.state.particles.x;
   const auto look = [&] {
     double mean = 0.0;
-    float deepest = 1e30f;
-    for (int i = 0; i < m.numCloth; ++i) {
-      mean += x[size_t(i)].y();
-      deepest = std::min(deepest, bodyDistance(m.colliders, s.state.time, x[size_t(i)], nullptr));
-    }
-    const std::vector<Vec3> cloth(x.begin(), x.begin() + m.numCloth);
-    return std::tuple{mean / m.numCloth, deepest, testing::countCrossingTriangles(cloth, m.triangles, piece.seams)};
+    for (int i = 0; i < m.numCloth; ++i) mean += x[size_t(i)].y();
+    return std::tuple{mean / m.numCloth, testing::deepestClothVertex(s), crossingPairs(s)};
   };
   StepStats total;
   testing::run(m, s.state, 90, &total);  // 1.5 s: sewn and settled, arms still down

@@ -5,8 +5,12 @@
 #include <soak/scene.hpp>
 #include <soak/step.hpp>
 
+#include "world/garment_mesh.hpp"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -40,6 +44,25 @@ inline std::string loadError(const std::string& text, const std::vector<std::str
     return e.what();
   }
   return "";
+}
+
+// the smallest distance of a cloth vertex to the scene's body (its colliders) at the scene's time;
+// negative: inside
+inline float deepestClothVertex(const Scene& s) {
+  float deepest = 1e30f;
+  for (int i = 0; i < s.model.numCloth; ++i)
+    deepest = std::min(deepest, bodyDistance(s.model.colliders, s.state.time, s.state.particles.x[size_t(i)], nullptr));
+  return deepest;
+}
+
+// writes an OBJ of the axis-aligned box [lo, hi], its faces wound outwards (a mesh or meshSequence
+// collider's frame)
+inline void writeBoxObj(const std::string& path, const Vec3& lo, const Vec3& hi) {
+  std::ofstream obj(path);
+  for (int k = 0; k < 8; ++k)
+    obj << "v " << (k & 1 ? hi : lo).x() << " " << (k & 2 ? hi : lo).y() << " " << (k & 4 ? hi : lo).z() << "\n";
+  obj << "f 1 3 2\nf 2 3 4\nf 5 6 7\nf 6 8 7\nf 1 2 5\nf 2 6 5\nf 3 7 4\nf 4 7 8\nf 1 5 3\nf 3 5 7\n"
+         "f 2 4 6\nf 4 8 6\n";
 }
 
 // `steps` steps of the scene's dt; the garment statistics summed into *total
